@@ -1,0 +1,91 @@
+// gtrack eval: estimates against ground truth (paper Section 5.1 metrics).
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "command.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/evaluation.hpp"
+#include "gtrack/setup.hpp"
+
+namespace po = boost::program_options;
+namespace fs = std::filesystem;
+
+namespace {
+
+void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) {
+  std::cout << "  " << std::left << std::setw(22) << name << std::right << std::fixed << std::setprecision(2)
+            << std::setw(9) << s.mean << " +- " << std::setw(7) << s.std << "  max " << std::setw(8) << s.max << " "
+            << unit << "\n";
+}
+
+int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
+  const fs::path truth_file = vm["truth"].as<std::string>();
+  const fs::path estimates_file = vm["estimates"].as<std::string>();
+  // The model comes from a config: the one given, or the sequence.toml that
+  // 'gtrack synth' wrote next to its ground truth.
+  fs::path config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
+                                       : truth_file.parent_path() / "sequence.toml";
+  if (!fs::exists(config)) {
+    throw gtrack::cli::UsageError("no --config given and no " + config.string() +
+                                  " next to the truth; the config names the gripper model");
+  }
+  gtrack::SetupOptions so;
+  so.plugin_paths = common.plugin_paths;
+  so.with_stimulus = false;
+  gtrack::Setup setup = gtrack::load_setup(config, so);
+  for (const auto& k : setup.root.keys()) setup.root.mark_used(k);  // engine tables are not used here
+
+  gtrack::EvalOptions opt;
+  opt.out_of_view_below = vm["out-of-view-below"].as<double>();
+  opt.off_track_endpoint_um = vm["off-track-um"].as<double>();
+  const auto truth = gtrack::read_pose_table(truth_file);
+  const auto estimates = gtrack::read_pose_table(estimates_file);
+  if (estimates.fingers != setup.model().fingers()) {
+    throw gtrack::InputError(estimates_file.string() + ": " + std::to_string(estimates.fingers) +
+                             " joint columns, the model in " + config.string() + " has " +
+                             std::to_string(setup.model().fingers()) + " fingers");
+  }
+  const auto ev = gtrack::evaluate(setup.model(), truth, estimates, opt, setup.sensor.get());
+
+  std::cout << "frames " << ev.frames << ": " << ev.in_view_frames << " in view (" << ev.evaluated_frames
+            << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames << " off track), "
+            << ev.out_of_view_frames << " out of view; lost in all " << ev.lost_frames << " (missing "
+            << ev.missing_frames << ")\n";
+  print_row("position 3D", ev.in_view.position_um, "um");
+  print_row("position in-plane", ev.in_view.position_inplane_um, "um");
+  print_row("depth", ev.in_view.depth_um, "um");
+  print_row("orientation", ev.in_view.orientation_deg, "deg");
+  print_row("  about x", ev.in_view.axis_deg[0], "deg");
+  print_row("  about y", ev.in_view.axis_deg[1], "deg");
+  print_row("  about z", ev.in_view.axis_deg[2], "deg");
+  print_row("joints", ev.in_view.joint_deg, "deg");
+  print_row("phalanx endpoints", ev.in_view.endpoint_um, "um");
+  std::cout << "  recovery: " << ev.recovery.size() << " returns into view, " << ev.frames_lost_after_return
+            << " frames lost or off track after them\n";
+  const std::string json = gtrack::evaluation_json(ev);
+  if (vm.count("json")) {
+    std::ofstream out(vm["json"].as<std::string>());
+    out << json;
+    if (!out) throw gtrack::InputError(vm["json"].as<std::string>() + ": cannot write");
+  }
+  if (vm.count("per-frame")) gtrack::write_frame_errors(vm["per-frame"].as<std::string>(), ev);
+  return 0;
+}
+
+}  // namespace
+
+GTRACK_COMMAND(
+    "eval", "compare estimates with ground truth: position, orientation, joint and endpoint errors, lost frames",
+    [](po::options_description& d) {
+      d.add_options()("truth,t", po::value<std::string>()->required(), "ground_truth.csv")(
+          "estimates,e", po::value<std::string>()->required(), "estimates.csv of 'gtrack track'")(
+          "config,c", po::value<std::string>(), "config naming the gripper (default: sequence.toml beside the truth)")(
+          "json", po::value<std::string>(), "write the summary as JSON")(
+          "per-frame", po::value<std::string>(), "write per-frame errors as CSV")(
+          "out-of-view-below", po::value<double>()->default_value(0.1),
+          "share of the gripper inside the image under which a frame counts as out of view")(
+          "off-track-um", po::value<double>()->default_value(400.0),
+          "mean endpoint error above which an estimate is off the gripper (recovery)");
+    },
+    run_eval)

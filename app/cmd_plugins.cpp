@@ -1,0 +1,34 @@
+// gtrack plugins: one line per plugin found (kind, name, version, file).
+#include <iostream>
+
+#include "command.hpp"
+#include "gtrack/plugin_loader.hpp"
+
+namespace {
+
+int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_options::variables_map& vm) {
+  gtrack::PluginLoader loader(common.plugin_paths);
+  const auto records = loader.discover();
+  if (vm.count("paths")) {
+    for (const auto& p : loader.search_paths()) std::cout << p.string() << "\n";
+    return 0;
+  }
+  if (records.empty()) {
+    std::cerr << "gtrack: no plugins found in: ";
+    for (const auto& p : loader.search_paths()) std::cerr << p.string() << " ";
+    std::cerr << "\n";
+    return 1;
+  }
+  for (const auto& r : records) {
+    std::cout << gtrack::to_string(r.kind) << "\t" << r.name << "\t" << r.version << "\t" << r.file.string() << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+GTRACK_COMMAND("plugins", "list the plugins found: kind, name, version, file",
+               [](boost::program_options::options_description& d) {
+                 d.add_options()("paths", "print the folders searched, in order, instead");
+               },
+               run_plugins)

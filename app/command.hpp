@@ -1,0 +1,50 @@
+// Subcommands of the gtrack executable.
+//
+// Each subcommand lives in its own cmd_<name>.cpp and registers itself with
+// GTRACK_COMMAND; main.cpp parses the common options (--plugin-path,
+// --log-level, --version), picks the subcommand and turns every gtrack::Error
+// into one line on stderr and exit code 1 (2 for a usage error).
+#pragma once
+
+#include <boost/program_options.hpp>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace gtrack::cli {
+
+struct CommonOptions {
+  std::vector<std::filesystem::path> plugin_paths;  // from --plugin-path, in order
+  std::string log_level = "info";
+};
+
+struct Command {
+  std::string name;
+  std::string summary;
+  // Declares the subcommand's own options (common ones are added by main).
+  std::function<void(boost::program_options::options_description&)> declare;
+  // Runs with the parsed options; returns the process exit code.
+  std::function<int(const CommonOptions&, const boost::program_options::variables_map&)> run;
+  // Positional arguments, if the command takes any.
+  std::vector<std::string> positional;
+};
+
+std::vector<Command>& registry();
+
+struct Registrar {
+  explicit Registrar(Command command) { registry().push_back(std::move(command)); }
+};
+
+// Thrown for a usage error (missing option, bad value); main prints the
+// message and a hint to --help, and exits with 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace gtrack::cli
+
+#define GTRACK_CLI_CONCAT2(a, b) a##b
+#define GTRACK_CLI_CONCAT(a, b) GTRACK_CLI_CONCAT2(a, b)
+#define GTRACK_COMMAND(...) \
+  static ::gtrack::cli::Registrar GTRACK_CLI_CONCAT(gtrack_command_, __LINE__){::gtrack::cli::Command{__VA_ARGS__}};

@@ -1,0 +1,121 @@
+// gtrack: one executable, one subcommand per job (see command.hpp).
+#include <boost/program_options.hpp>
+#include <cstdio>
+#include <iostream>
+
+#include "command.hpp"
+#include "gtrack/config.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
+#include "gtrack/version.hpp"
+
+namespace po = boost::program_options;
+using gtrack::cli::Command;
+using gtrack::cli::registry;
+
+namespace gtrack::cli {
+std::vector<Command>& registry() {
+  static std::vector<Command> commands;
+  return commands;
+}
+}  // namespace gtrack::cli
+
+namespace {
+
+po::options_description common_options() {
+  po::options_description d("Common options");
+  d.add_options()("help,h", "show this help")("version", "print the version and exit")(
+      "log-level", po::value<std::string>()->default_value("info"),
+      "trace, debug, info, warn, error, critical or off")(
+      "plugin-path", po::value<std::vector<std::string>>()->composing(),
+      "extra folder searched for plugins first (repeatable)");
+  return d;
+}
+
+void print_usage(std::ostream& os) {
+  os << "gtrack " << GTRACK_VERSION_STRING
+     << " - model-based tracking of untethered micro-grippers\n\n"
+        "Usage: gtrack <command> [options]   (gtrack <command> --help for its options)\n\nCommands:\n";
+  auto cmds = registry();
+  std::sort(cmds.begin(), cmds.end(), [](const Command& a, const Command& b) { return a.name < b.name; });
+  for (const auto& c : cmds) {
+    os << "  " << c.name << std::string(c.name.size() < 10 ? 10 - c.name.size() : 1, ' ') << c.summary << "\n";
+  }
+  os << "\n" << common_options();
+}
+
+int run(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage(std::cerr);
+    return 2;
+  }
+  const std::string first = argv[1];
+  if (first == "--version") {
+    std::cout << "gtrack " << GTRACK_VERSION_STRING << " (plugin ABI " << GTRACK_PLUGIN_ABI_VERSION << ")\n";
+    return 0;
+  }
+  if (first == "--help" || first == "-h" || first == "help") {
+    print_usage(std::cout);
+    return 0;
+  }
+  const Command* cmd = nullptr;
+  for (const auto& c : registry()) {
+    if (c.name == first) cmd = &c;
+  }
+  if (!cmd) {
+    std::vector<std::string> names;
+    for (const auto& c : registry()) names.push_back(c.name);
+    std::string msg = "gtrack: unknown command '" + first + "'";
+    if (auto m = gtrack::closest_match(first, names)) msg += " (did you mean '" + *m + "'?)";
+    std::cerr << msg << "; run 'gtrack --help' for the list\n";
+    return 2;
+  }
+
+  po::options_description own("Options of 'gtrack " + cmd->name + "'");
+  if (cmd->declare) cmd->declare(own);
+  po::options_description all;
+  all.add(own).add(common_options());
+  po::positional_options_description pos;
+  for (const auto& p : cmd->positional) pos.add(p.c_str(), 1);
+  po::variables_map vm;
+  try {
+    po::store(po::command_line_parser(argc - 1, argv + 1).options(all).positional(pos).run(), vm);
+    if (vm.count("help")) {
+      std::cout << "gtrack " << cmd->name << ": " << cmd->summary << "\n\n" << all;
+      return 0;
+    }
+    if (vm.count("version")) {
+      std::cout << "gtrack " << GTRACK_VERSION_STRING << "\n";
+      return 0;
+    }
+    po::notify(vm);
+  } catch (const po::error& e) {
+    std::cerr << "gtrack " << cmd->name << ": " << e.what() << " (see 'gtrack " << cmd->name << " --help')\n";
+    return 2;
+  }
+
+  gtrack::cli::CommonOptions common;
+  common.log_level = vm["log-level"].as<std::string>();
+  gtrack::set_log_level(common.log_level);
+  if (vm.count("plugin-path")) {
+    for (const auto& p : vm["plugin-path"].as<std::vector<std::string>>()) common.plugin_paths.emplace_back(p);
+  }
+  return cmd->run(common, vm);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const gtrack::cli::UsageError& e) {
+    std::cerr << "gtrack: " << e.what() << "\n";
+    return 2;
+  } catch (const gtrack::Error& e) {
+    std::cerr << "gtrack: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "gtrack: error: " << e.what() << "\n";
+    return 1;
+  }
+}

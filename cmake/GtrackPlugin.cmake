@@ -1,0 +1,40 @@
+# gtrack_add_plugin(NAME KIND sensor|gripper|stimulus SOURCES ...)
+#
+# Builds one runtime-loaded gtrack plugin: a shared library with hidden
+# visibility, linked to the framework, placed where gtrack searches for plugins.
+# Used for the built-in plugins and, through find_package(gtrack), by plugin
+# authors out of tree.
+function(gtrack_add_plugin name)
+  cmake_parse_arguments(ARG "" "KIND;OUTPUT_DIRECTORY" "SOURCES" ${ARGN})
+  if(NOT ARG_KIND MATCHES "^(sensor|gripper|stimulus)$")
+    message(FATAL_ERROR "gtrack_add_plugin(${name}): KIND must be sensor, gripper or stimulus, got '${ARG_KIND}'")
+  endif()
+  if(NOT ARG_SOURCES)
+    message(FATAL_ERROR "gtrack_add_plugin(${name}): SOURCES is empty")
+  endif()
+  add_library(${name} MODULE ${ARG_SOURCES})
+  if(TARGET gtrack::framework)
+    target_link_libraries(${name} PRIVATE gtrack::framework)
+  else()
+    target_link_libraries(${name} PRIVATE gtrack_framework)
+  endif()
+  set_target_properties(${name} PROPERTIES
+    PREFIX "libgtrack_"
+    CXX_VISIBILITY_PRESET hidden
+    VISIBILITY_INLINES_HIDDEN ON
+    CXX_STANDARD 20
+    CXX_STANDARD_REQUIRED ON)
+  target_compile_definitions(${name} PRIVATE GTRACK_PLUGIN_KIND_${ARG_KIND}=1)
+  # A missing symbol is a link error now rather than a load error later.
+  if(NOT APPLE)
+    target_link_options(${name} PRIVATE -Wl,--no-undefined)
+  endif()
+  if(ARG_OUTPUT_DIRECTORY)
+    set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${ARG_OUTPUT_DIRECTORY}")
+  elseif(DEFINED GTRACK_PLUGIN_OUTPUT_DIR)
+    set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${GTRACK_PLUGIN_OUTPUT_DIR}")
+  endif()
+  if(DEFINED GTRACK_PLUGIN_SUBDIR AND NOT GTRACK_PLUGIN_EXTERNAL)
+    install(TARGETS ${name} LIBRARY DESTINATION "${GTRACK_PLUGIN_SUBDIR}")
+  endif()
+endfunction()

@@ -1,0 +1,103 @@
+// The engine's own config tables, read and validated in one place.
+//
+// A config names three plugins ([sensor], [gripper], [stimulus]) whose tables
+// the plugins read; every other table belongs to the engine: [observation]
+// (segmentation), [pso] (Algorithm 1), [cost] (eq. 1 weights), [render]
+// (backend and scale), [search] (bounds of the hypothesis space) and
+// [tracker] (initial pose, initial spreads, frame rate, lost handling).
+// engine_config() reads all of them, with the paper's defaults, and checks
+// that each table holds no unknown key (file, line, key, suggestion).
+// Defaults that depend on the setup (search box, spreads) are derived from the
+// sensor's nominal position and the model's size.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gtrack/config.hpp"
+#include "gtrack/export.hpp"
+#include "gtrack/parameter_space.hpp"
+#include "gtrack/renderer.hpp"
+
+namespace gtrack {
+
+struct Setup;
+
+// Segmentation (paper 2.1) and temporal continuity (paper 3, last paragraph).
+struct ObservationConfig {
+  std::string color_space = "hsv";  // "hsv" (camera) or "luminance" (ultrasound)
+  // HSV bounds in OpenCV units (H in [0, 180), S and V in [0, 255]); the paper
+  // bounds S and V only, so H is open by default.
+  double hue_min = 0, hue_max = 180;
+  double saturation_min = 60, saturation_max = 255;
+  double value_min = 0, value_max = 255;
+  double luminance_min = 128, luminance_max = 255;
+  int open_kernel_px = 3;           // morphological opening, full-resolution pixels; 0 = off
+  double downscale_threshold = 0.5; // a render pixel is set when this share of its area is
+  bool roi = true;                  // search only around the previous estimate
+  double roi_margin_px = 48;        // margin around its projected box, full-resolution pixels
+  bool prior = true;                // drop pixels unlikely given the previous model
+  double prior_sigma_px = 24;       // full-resolution pixels
+  double prior_threshold = 0.05;    // keep p(O_t+1 | P_t) = exp(-d^2 / 2 sigma^2) above this
+};
+
+struct PsoConfig {
+  int particles = 32;              // N
+  int generations = 25;            // G
+  double inertia = 0.4;            // w
+  double c = 1.0;                  // C of the rank-adaptive coefficients
+  int randomize_every = 8;         // k_r; 0 = never
+  double randomize_fraction = 0.25;  // share of the swarm partially randomised
+  double max_velocity_fraction = 0.5;  // |v_d| <= this * (upper_d - lower_d); 0 = no clamp
+  std::uint64_t seed = 1;
+};
+
+struct CostWeights {
+  double dice = 2.0;        // lambda_D
+  double kinematic = 0.15;  // lambda_K
+  double stimulus = 1.0;    // lambda_S
+};
+
+struct SearchConfig {
+  Eigen::Vector3d position_min_mm{0, 0, 0}, position_max_mm{0, 0, 0};
+  Eigen::Vector3d rotation_min_deg{-90, -90, -180}, rotation_max_deg{90, 90, 180};
+};
+
+struct TrackerConfig {
+  std::optional<Eigen::VectorXd> initial_pose;  // none: coarse search on the first frame
+  // Half-widths of the uniform perturbation of the previous best:
+  // x, y, z (mm), rx, ry, rz (deg), joints (deg).
+  Eigen::Matrix<double, 7, 1> init_spread = Eigen::Matrix<double, 7, 1>::Zero();
+  double fps = 0;                        // 0: from the video, else 30
+  std::optional<double> default_stimulus;  // used when no stimulus log is given
+  double lost_dice = 0.95;               // best D above this: the gripper is not where we think
+  int reinit_after_lost = 3;             // lost frames before the coarse search takes over
+  int coarse_rz_steps = 12;              // rz hypotheses over one symmetry period
+  int coarse_candidates = 4;             // best coarse hypotheses refined by a PSO each
+  int progress_every = 50;               // frames between progress lines when stderr is not a terminal
+  bool overlay = true;                   // write overlay.mp4
+};
+
+struct EngineConfig {
+  ObservationConfig observation;
+  PsoConfig pso;
+  CostWeights cost;
+  RenderOptions render;
+  SearchConfig search;
+  TrackerConfig tracker;
+  ParameterSpace space;  // from [search] and the gripper's joint limits
+};
+
+// Reads [observation], [pso], [cost], [render], [search], [tracker] from the
+// setup's root table (defaults from the sensor and the model), checks every
+// key of those tables, marks them used on the root. Throws ConfigError.
+GTRACK_API EngineConfig engine_config(const Setup& setup);
+
+// After engine_config(): every root key that neither the plugins nor the
+// engine read is an error (e.g. a misspelled table name).
+GTRACK_API void check_root_keys(const Setup& setup);
+
+}  // namespace gtrack

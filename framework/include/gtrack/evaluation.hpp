@@ -1,0 +1,116 @@
+// Tracking accuracy against ground truth (paper Section 5.1, Fig. 6).
+//
+// Per frame, an estimate is compared with the truth after choosing, among
+// the gripper's rotationally symmetric equivalents
+// (ArticulatedModel::symmetric_equivalent, k = 0..order-1), the one whose
+// phalanx endpoints lie closest to the truth's: a six-finger gripper turned
+// by 60 degrees with its fingers renumbered is the same physical thing and
+// must score zero. Errors: palm-centre position (3D, in the image plane x-y,
+// depth z; micrometres), orientation (geodesic angle between the rotations,
+// and per Euler axis; degrees), joints (mean absolute over fingers; degrees)
+// and the mean distance between corresponding phalanx endpoints
+// (micrometres, the paper's Fig. 6 metric).
+//
+// Nothing is dropped silently. A frame without an estimate row, or with
+// status "lost", is counted as lost; frames whose truth is (almost) outside
+// the view are kept apart from the in-view statistics and summarised on
+// their own; after each stretch outside the view, the frames it takes the
+// tracker to be back on the gripper are counted (recovery).
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "gtrack/export.hpp"
+#include "gtrack/model.hpp"
+#include "gtrack/sensor.hpp"
+#include "gtrack/sequence_io.hpp"
+
+namespace gtrack {
+
+struct EvalOptions {
+  // A truth frame with less than this share of the gripper inside the image
+  // is "out of view" (ground_truth.csv's in_view column; computed from the
+  // sensor when the column is absent).
+  double out_of_view_below = 0.1;
+  // An estimate whose mean endpoint error exceeds this is off the gripper:
+  // it counts as not yet recovered after a return into view.
+  double off_track_endpoint_um = 400;
+};
+
+struct ErrorStats {
+  double mean = 0, std = 0, max = 0;
+  int count = 0;
+};
+
+struct FrameErrors {
+  double position_um = 0, inplane_um = 0, depth_um = 0;
+  double orientation_deg = 0;
+  Eigen::Vector3d axis_deg{0, 0, 0};  // |Euler angle differences| about x, y, z
+  double joint_deg = 0;
+  double endpoint_um = 0;
+  int symmetry_k = 0;  // the equivalent of the estimate that was compared
+};
+
+// Compares one estimate with one truth, modulo the model's symmetry.
+GTRACK_API FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorXd& truth,
+                                        const Eigen::VectorXd& estimate);
+// Angle (deg) of the rotation between two Euler triples (rx, ry, rz in deg).
+GTRACK_API double geodesic_angle_deg(const Eigen::Vector3d& euler_a, const Eigen::Vector3d& euler_b);
+
+struct FrameEvaluation {
+  int frame = 0;
+  double in_view = 1;
+  bool out_of_view = false;
+  bool has_estimate = false;
+  bool lost = false;      // no row, status "lost", or a non-finite estimate
+  std::string status;
+  FrameErrors errors;     // valid when has_estimate && !lost
+};
+
+struct ErrorSet {
+  ErrorStats position_um, position_inplane_um, depth_um, orientation_deg, joint_deg, endpoint_um;
+  ErrorStats axis_deg[3];
+  void add(const FrameErrors& e);
+  void finish();
+ private:
+  std::vector<double> sq_[9];
+};
+
+struct RecoveryEpisode {
+  int returned_at = 0;        // first frame back in view
+  int frames_to_recover = 0;  // frames lost or off track from there on
+  bool recovered = false;
+};
+
+struct Evaluation {
+  EvalOptions options;
+  int frames = 0;             // truth frames
+  int in_view_frames = 0;
+  int out_of_view_frames = 0;
+  int evaluated_frames = 0;   // in view, with a usable estimate
+  int lost_frames = 0;        // all frames (status lost or missing)
+  int lost_in_view_frames = 0;
+  int missing_frames = 0;     // no estimate row at all
+  int search_frames = 0;      // status "search" (coarse search)
+  int off_track_frames = 0;   // in view, estimate present but endpoint error above the threshold
+  ErrorSet in_view;           // the headline numbers
+  ErrorSet out_of_view;       // frames mostly outside the view that still got an estimate
+  std::vector<RecoveryEpisode> recovery;
+  int frames_lost_after_return = 0;
+  std::vector<FrameEvaluation> per_frame;
+};
+
+// `sensor` is used only when the truth has no in_view column (may be null:
+// then every frame counts as in view).
+GTRACK_API Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const PoseTable& estimates,
+                               const EvalOptions& options = {}, const Sensor* sensor = nullptr);
+
+// The evaluation as one JSON object (keys as in DESIGN.md, plus the rest).
+GTRACK_API std::string evaluation_json(const Evaluation& evaluation);
+// Per-frame errors as CSV.
+GTRACK_API void write_frame_errors(const std::filesystem::path& file, const Evaluation& evaluation);
+
+}  // namespace gtrack

@@ -1,0 +1,88 @@
+// The hot path: N pose hypotheses in, N pairs of pixel counts out (paper 4).
+//
+// A Renderer caches the gripper model once, takes the sensor's Projection and
+// a render scale (paper: 1/4 of the image side), and holds the current
+// observation mask at render size. For a batch of hypotheses (one per column,
+// see parameter_space.hpp) it returns, per hypothesis,
+//   intersection = |O & P|  and  rendered = |P|,
+// from which |O | P| = |O| + |P| - |O & P|. Both backends fill triangles with
+// the pixel-centre rule (pixel (i, j) is covered when (i + 0.5, j + 0.5) is
+// inside, top-left rule on edges), after clipping against the projection's
+// clip planes; a mask is the union of the triangles, never a sum.
+//
+// submit() starts a batch and returns at once where the backend can work
+// asynchronously (gl): the caller computes K(H), S(H) and swarm bookkeeping,
+// then finish() waits for the counts.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "gtrack/export.hpp"
+#include "gtrack/model.hpp"
+#include "gtrack/sensor.hpp"
+
+namespace gtrack {
+
+struct PairCounts {
+  std::uint32_t intersection = 0;  // |O & P|
+  std::uint32_t rendered = 0;      // |P|
+};
+
+struct RenderOptions {
+  std::string backend = "auto";  // "auto" | "gl" | "cpu"
+  double scale = 0.25;           // render size = round(scale * image size)
+  int threads = 0;               // cpu backend worker threads; 0 = hardware concurrency
+  std::string egl_device;        // gl: device index or "surfaceless"; "" = GTRACK_EGL_DEVICE or auto
+};
+
+class GTRACK_API Renderer {
+ public:
+  virtual ~Renderer();
+
+  virtual std::string name() const = 0;
+  virtual void set_model(const ArticulatedModel& model) = 0;
+  virtual void set_projection(const Projection& projection, double scale) = 0;
+  virtual ImageSize render_size() const = 0;
+  // CV_8U at render_size(); non-zero pixels belong to the observation.
+  virtual void set_observation(const cv::Mat& mask) = 0;
+  // |O| of the current observation.
+  virtual std::uint64_t observation_count() const = 0;
+
+  virtual void submit(const Eigen::MatrixXd& hypotheses) = 0;
+  virtual void finish(std::vector<PairCounts>& out) = 0;
+  void evaluate(const Eigen::MatrixXd& hypotheses, std::vector<PairCounts>& out) {
+    submit(hypotheses);
+    finish(out);
+  }
+
+  // One hypothesis as a CV_8U mask (0 / 255) at render_size().
+  virtual cv::Mat render_mask(const Eigen::VectorXd& hypothesis) = 0;
+};
+
+// Creates a backend. "auto" takes gl when a hardware GPU is found, else cpu.
+// Throws gtrack::Error with the reason when the requested backend cannot run.
+GTRACK_API std::unique_ptr<Renderer> make_renderer(const RenderOptions& options);
+GTRACK_API std::unique_ptr<Renderer> make_cpu_renderer(const RenderOptions& options);
+GTRACK_API std::unique_ptr<Renderer> make_gl_renderer(const RenderOptions& options);
+// True when a hardware (non-software) GPU is reachable through EGL.
+GTRACK_API bool hardware_gpu_available();
+
+// The projection scaled to render resolution.
+GTRACK_API Projection scaled_projection(const Projection& projection, double scale);
+
+// Geometry both backends share: the posed, projected and clipped triangles of
+// one hypothesis in render pixels (each polygon a fan after clipping). Used by
+// the cpu backend, the reference rasteriser in tests and the overlay.
+struct ScreenPolygon {
+  int count = 0;
+  Eigen::Vector2d v[9];  // a triangle clipped by two planes has at most 5; room to spare
+};
+GTRACK_API void project_and_clip(const std::vector<Eigen::Vector3d>& world_triangles,
+                                 const Projection& render_projection, std::vector<ScreenPolygon>& out);
+
+}  // namespace gtrack

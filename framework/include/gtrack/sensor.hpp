@@ -1,0 +1,61 @@
+// Sensor plugins: how the world becomes an image.
+//
+// A sensor tells the renderers everything they need, as data, so that a new
+// imaging model needs no change in any render backend:
+//   - a 3x4 matrix taking world points (mm) to homogeneous image coordinates
+//     (u*w, v*w, w) in pixels of the full-resolution image (pixel centres at
+//     +0.5; a point is imaged when w > 0),
+//   - up to two clip planes in world coordinates (n.x + d >= 0 is kept): the
+//     pinhole's near plane, the ultrasound slab's two faces.
+// Both backends clip triangles against the planes, divide by w and fill with
+// the pixel-centre rule. project() is the full model (with lens distortion)
+// used for drawing overlays and for tests.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gtrack/export.hpp"
+
+namespace gtrack {
+
+struct ImageSize {
+  int width = 0;
+  int height = 0;
+};
+
+struct Projection {
+  Eigen::Matrix<double, 3, 4> world_to_image = Eigen::Matrix<double, 3, 4>::Zero();
+  std::vector<Eigen::Vector4d> clip_planes;  // (n, d): keep n.x + d >= 0
+  ImageSize size;
+};
+
+// What the observation step should do with this sensor's frames by default.
+struct SegmentationDefaults {
+  std::string color_space = "hsv";  // "hsv" (camera) or "luminance" (ultrasound)
+};
+
+class GTRACK_API Sensor {
+ public:
+  virtual ~Sensor();
+
+  virtual ImageSize image_size() const = 0;
+  virtual Projection projection() const = 0;
+  // Pixel coordinates of a world point, distortion included; nullopt if the
+  // point is not imaged (behind the camera, outside the slab).
+  virtual std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& world_mm) const = 0;
+  // Removes what the linear projection does not model (lens distortion) from
+  // an input frame; the default returns the frame unchanged.
+  virtual cv::Mat rectify(const cv::Mat& frame) const;
+  virtual SegmentationDefaults segmentation_defaults() const;
+  // A typical world position for the gripper in view (mm), for synthetic
+  // sequences and the first-frame search.
+  virtual Eigen::Vector3d nominal_position_mm() const = 0;
+  // Millimetres per pixel at the nominal position (for metrics and presets).
+  virtual double mm_per_pixel() const = 0;
+};
+
+}  // namespace gtrack

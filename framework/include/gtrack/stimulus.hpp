@@ -1,0 +1,51 @@
+// Stimulus plugins: what the gripper's material responds to (paper 2.2, 3).
+//
+// One instance follows one sequence: update() is called once per frame with
+// the reading(s) of that frame, in order. From its state the plugin supplies
+// S(H), the penalty for joint values the stimulus makes infeasible, and the
+// bias of the swarm's initial joint values.
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "gtrack/export.hpp"
+
+namespace gtrack {
+
+enum class StimulusTrend { Steady, Folding, Unfolding };
+
+struct StimulusState {
+  double value = 0;                 // the latest reading (e.g. degrees Celsius)
+  double rate = 0;                  // smoothed change per second (or per frame)
+  StimulusTrend trend = StimulusTrend::Steady;
+  bool in_transition = false;       // inside the range where the gripper changes shape
+  // Joint range (degrees) the stimulus allows now; joints outside it are
+  // infeasible and count in S(H).
+  double feasible_min_deg = -1e9;
+  double feasible_max_deg = 1e9;
+};
+
+class GTRACK_API Stimulus {
+ public:
+  virtual ~Stimulus();
+
+  // Feeds one frame's reading; time_s is the frame time (monotonic).
+  virtual void update(double value, double time_s) = 0;
+  virtual StimulusState state() const = 0;
+  // S(H): mean absolute error of the infeasible joints against the reference
+  // values, normalised by the folded-unfolded span; 0 if all are feasible.
+  virtual double penalty(std::span<const double> joints_deg) const = 0;
+  // Fraction of the swarm whose joints start increased (folding); the rest
+  // start decreased. Paper: 0.75 when folding is likely, 0.25 when unfolding
+  // is likely, 0.5 otherwise.
+  virtual double fold_fraction() const = 0;
+  // For synthetic sequences: the joint value a gripper at `current_deg` moves
+  // towards under the present state.
+  virtual double target_joint_deg(double current_deg) const = 0;
+  // Name and unit of the reading, for logs and overlays ("T", "C").
+  virtual std::string reading_label() const;
+  virtual std::string reading_unit() const;
+};
+
+}  // namespace gtrack

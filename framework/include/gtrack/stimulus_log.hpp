@@ -1,0 +1,42 @@
+// The stimulus reading of every frame, from a CSV log.
+//
+// Two forms, chosen by the header: `frame,value` (one row per frame index;
+// frames between rows take the linearly interpolated value) or
+// `time_s,value` (interpolated at the frame's time, index / fps). Rows must
+// be increasing in the key column. A malformed row is an InputError
+// "file:line: expected <what>, got '<text>'". A frame before the first or
+// after the last row is outside the log: value_at() returns nullopt and the
+// tracker warns once and holds the nearest reading.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gtrack/export.hpp"
+
+namespace gtrack {
+
+class GTRACK_API StimulusLog {
+ public:
+  enum class Key { Frame, Time };
+
+  static StimulusLog load(const std::filesystem::path& file);
+  static StimulusLog parse(const std::string& text, const std::string& source = "<string>");
+
+  Key key() const { return key_; }
+  // The reading for a frame (index and time); nullopt outside the log.
+  std::optional<double> value_at(int frame, double time_s) const;
+  // The reading of the nearest row (for frames outside the log).
+  double nearest(int frame, double time_s) const;
+  size_t rows() const { return keys_.size(); }
+  const std::string& source() const { return source_; }
+
+ private:
+  Key key_ = Key::Frame;
+  std::vector<double> keys_, values_;
+  std::string source_;
+};
+
+}  // namespace gtrack

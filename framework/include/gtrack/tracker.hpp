@@ -1,0 +1,144 @@
+// The tracker: one frame in, the gripper's configuration out (paper Fig. 2).
+//
+// Tracker is the per-frame API: process() segments the frame into the
+// observation O (with the previous estimate's ROI and prior), feeds the
+// stimulus reading to the Stimulus plugin, initialises the swarm from the
+// previous best (biased by Stimulus::fold_fraction), runs Algorithm 1 with
+// every generation rendered and counted as one batch, and returns the best
+// hypothesis g^ with its cost terms.
+//
+// The first frame starts from [tracker] initial_pose when configured, else
+// from a coarse search: the observation's centroid is lifted to 3D at the
+// sensor's nominal depth, a grid of rz / tilt / joint hypotheses there is
+// scored in batches, and the best few are refined by a PSO each.
+//
+// Lost: a frame whose observation is empty (or whose best D exceeds
+// [tracker] lost_dice) is reported with status "lost", the previous estimate
+// is held, and the search region of the next frame grows with each lost
+// frame. After reinit_after_lost lost frames the next frame with anything
+// detected in the full image is re-initialised by the coarse search
+// (status "search").
+//
+// track_sequence() is the whole `gtrack track` job as a library call: frames
+// from a source, stimulus from a CSV, results, overlay and summary written to
+// a folder as they are computed. It stops cleanly between frames when the
+// cancel flag is raised.
+#pragma once
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <random>
+#include <string>
+
+#include "gtrack/cost.hpp"
+#include "gtrack/engine_config.hpp"
+#include "gtrack/export.hpp"
+#include "gtrack/frame_source.hpp"
+#include "gtrack/observation.hpp"
+#include "gtrack/pso.hpp"
+#include "gtrack/renderer.hpp"
+#include "gtrack/setup.hpp"
+
+namespace gtrack {
+
+enum class TrackStatus {
+  Tracked,  // "ok": PSO from the previous estimate
+  Search,   // "search": coarse search (first frame, after a loss)
+  Lost,     // "lost": nothing usable detected; the previous estimate is held
+};
+GTRACK_API const char* to_string(TrackStatus status);
+
+// Milliseconds spent per stage of one frame.
+struct StageTimes {
+  double segment_ms = 0;
+  double pso_ms = 0;
+  double io_ms = 0;  // reading the frame, writing results and overlay
+};
+
+struct Estimate {
+  int frame = 0;
+  double time_s = 0;
+  Eigen::VectorXd hypothesis;  // g^: x,y,z (mm), rx,ry,rz (deg), q1..qF (deg)
+  CostTerms terms;             // of g^ against this frame's observation
+  TrackStatus status = TrackStatus::Tracked;
+  std::optional<double> stimulus;  // the reading used for this frame
+  std::uint64_t observed_pixels = 0;  // |O|
+  std::uint64_t evaluations = 0;      // hypotheses scored for this frame
+  StageTimes times;
+  double ms = 0;  // segment + PSO (the tracker's own time for the frame)
+};
+
+class GTRACK_API Tracker {
+ public:
+  // Makes the renderer named by config.render.
+  Tracker(const Setup& setup, EngineConfig config);
+  // With a renderer of the caller's (e.g. one shared by tests).
+  Tracker(const Setup& setup, EngineConfig config, std::unique_ptr<Renderer> renderer);
+  ~Tracker();
+  Tracker(const Tracker&) = delete;
+  Tracker& operator=(const Tracker&) = delete;
+
+  // Tracks one frame (BGR at the sensor's image size). `stimulus` is the
+  // reading for this frame; nullopt = no reading (the configured default is
+  // used if any, else S and the bias are off).
+  Estimate process(const cv::Mat& frame, int index, double time_s, std::optional<double> stimulus);
+
+  // Forget the history: the next frame starts like the first.
+  void reset();
+  // Start the next frame from this hypothesis (as if it were the last estimate).
+  void set_estimate(const Eigen::VectorXd& hypothesis);
+  const std::optional<Eigen::VectorXd>& last_estimate() const;
+
+  // The observation of the last processed frame (render size, 0/255).
+  const Observation& last_observation() const;
+  // The estimate drawn on a frame: posed triangles projected with
+  // Sensor::project and filled in green with alpha, plus the stimulus reading
+  // in the bottom-right corner.
+  cv::Mat draw_overlay(const cv::Mat& frame, const Estimate& estimate) const;
+
+  Renderer& renderer();
+  const EngineConfig& config() const;
+  const ParameterSpace& space() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct TrackOptions {
+  std::string input;                          // video file, image folder or "camera:N"
+  std::optional<std::filesystem::path> stimulus_csv;
+  std::filesystem::path out_dir;
+  FrameRange range;                           // --frames A:B, --every K
+  bool save_masks = false;                    // out_dir/masks/NNNNNN.png (observation O)
+  std::optional<bool> overlay;                // overrides [tracker] overlay
+  bool progress = true;                       // progress line on stderr
+  const std::atomic<bool>* cancel = nullptr;  // raised: finish the frame, close files, return
+  std::function<void(const Estimate&)> on_frame;  // called after each frame is written
+};
+
+struct TrackSummary {
+  int frames = 0;
+  int lost_frames = 0;
+  double mean_cost = 0;      // over frames not lost
+  double mean_ms = 0;        // tracker time per frame
+  StageTimes mean_times;     // per stage, per frame
+  double wall_s = 0;
+  bool cancelled = false;
+  std::string renderer;
+  std::filesystem::path overlay_file;  // empty if none was written
+};
+
+// Runs the tracker over a source and writes, in options.out_dir:
+// estimates.csv, estimates.jsonl (appended and flushed per frame),
+// overlay.mp4 (or overlay.avi), masks/ (with save_masks) and summary.json.
+// Throws InputError for unusable inputs or an unwritable folder.
+GTRACK_API TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options);
+
+}  // namespace gtrack

@@ -1,0 +1,376 @@
+// ConfigTable: TOML++ kept inside the framework, key tracking, and errors
+// that name file, line and key.
+#include "gtrack/config.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+struct ConfigTable::Impl {
+  std::shared_ptr<toml::table> root;  // keeps the document alive
+  const toml::table* table = nullptr; // this table inside root (nullptr: empty)
+  std::string source;
+  std::string path;
+  std::shared_ptr<std::set<std::string>> used = std::make_shared<std::set<std::string>>();
+  int line = 0;  // where the table starts, for keys that are missing
+};
+
+namespace {
+
+std::string describe_range(const Range& r) {
+  std::ostringstream s;
+  if (r.min && r.max) {
+    s << "a number in " << (r.min_exclusive ? "(" : "[") << *r.min << ", " << *r.max << (r.max_exclusive ? ")" : "]");
+  } else if (r.min) {
+    s << "a number " << (r.min_exclusive ? "> " : ">= ") << *r.min;
+  } else if (r.max) {
+    s << "a number " << (r.max_exclusive ? "< " : "<= ") << *r.max;
+  } else {
+    s << "a number";
+  }
+  return s.str();
+}
+
+bool in_range(double v, const Range& r) {
+  if (!std::isfinite(v)) return false;
+  if (r.min && (r.min_exclusive ? v <= *r.min : v < *r.min)) return false;
+  if (r.max && (r.max_exclusive ? v >= *r.max : v > *r.max)) return false;
+  return true;
+}
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+std::optional<double> as_number(const toml::node& n) {
+  if (auto v = n.value_exact<double>()) return *v;
+  if (auto v = n.value_exact<int64_t>()) return static_cast<double>(*v);
+  return std::nullopt;
+}
+
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      size_t sub = prev[j - 1] + (std::tolower(a[i - 1]) == std::tolower(b[j - 1]) ? 0 : 1);
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+}  // namespace
+
+std::optional<std::string> closest_match(std::string_view word, const std::vector<std::string>& candidates) {
+  std::optional<std::string> best;
+  size_t best_d = std::max<size_t>(2, word.size() / 3) + 1;
+  for (const auto& c : candidates) {
+    size_t d = edit_distance(word, c);
+    if (d < best_d) {
+      best_d = d;
+      best = c;
+    }
+  }
+  return best;
+}
+
+ConfigTable::ConfigTable() : impl_(std::make_shared<Impl>()) {}
+ConfigTable::ConfigTable(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ConfigTable::~ConfigTable() = default;
+ConfigTable::ConfigTable(const ConfigTable&) = default;
+ConfigTable& ConfigTable::operator=(const ConfigTable&) = default;
+
+ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
+  auto impl = std::make_shared<Impl>();
+  try {
+    impl->root = std::make_shared<toml::table>(toml::parse(text, source));
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << source << ":" << e.source().begin.line << ": " << e.description();
+    throw ConfigError(s.str());
+  }
+  impl->table = impl->root.get();
+  impl->source = std::move(source);
+  impl->line = 1;
+  return ConfigTable(impl);
+}
+
+ConfigTable ConfigTable::load_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ": cannot open config file (does it exist and is it readable?)");
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw ConfigError(path + ": cannot read config file");
+  return parse(s.str(), path);
+}
+
+const std::string& ConfigTable::source() const { return impl_->source; }
+const std::string& ConfigTable::path() const { return impl_->path; }
+
+std::string ConfigTable::where(std::string_view key) const {
+  std::ostringstream s;
+  int line = impl_->line;
+  if (impl_->table) {
+    if (auto* n = impl_->table->get(key)) line = static_cast<int>(n->source().begin.line);
+  }
+  s << (impl_->source.empty() ? std::string("<config>") : impl_->source);
+  if (line > 0) s << ":" << line;
+  s << ": ";
+  std::string full = impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key);
+  s << "key '" << full << "'";
+  return s.str();
+}
+
+void ConfigTable::fail(std::string_view key, std::string_view message) const {
+  throw ConfigError(where(key) + ": " + std::string(message));
+}
+
+bool ConfigTable::has(std::string_view key) const {
+  return impl_->table && impl_->table->contains(key);
+}
+
+std::vector<std::string> ConfigTable::keys() const {
+  std::vector<std::pair<int, std::string>> ks;
+  if (impl_->table) {
+    for (auto&& [k, v] : *impl_->table) ks.emplace_back(static_cast<int>(v.source().begin.line), std::string(k.str()));
+  }
+  std::stable_sort(ks.begin(), ks.end());
+  std::vector<std::string> out;
+  for (auto& [l, k] : ks) out.push_back(k);
+  return out;
+}
+
+void ConfigTable::mark_used(std::string_view key) const { impl_->used->insert(std::string(key)); }
+
+namespace {
+const toml::node* lookup(const ConfigTable::Impl& impl, std::string_view key) {
+  impl.used->insert(std::string(key));
+  return impl.table ? impl.table->get(key) : nullptr;
+}
+}  // namespace
+
+double ConfigTable::number(std::string_view key, Range range) const {
+  const toml::node* n = lookup(*impl_, key);
+  if (!n) fail(key, "missing; expected " + describe_range(range));
+  auto v = as_number(*n);
+  if (!v) fail(key, std::string("expected ") + describe_range(range) + ", got " + type_name(*n));
+  if (!in_range(*v, range)) {
+    std::ostringstream s;
+    s << "value " << *v << " is out of range; expected " << describe_range(range);
+    fail(key, s.str());
+  }
+  return *v;
+}
+
+double ConfigTable::number_or(std::string_view key, double fallback, Range range) const {
+  if (!has(key)) {
+    mark_used(key);
+    return fallback;
+  }
+  return number(key, range);
+}
+
+long long ConfigTable::integer(std::string_view key, Range range) const {
+  const toml::node* n = lookup(*impl_, key);
+  if (!n) fail(key, "missing; expected an integer");
+  auto v = n->value_exact<int64_t>();
+  if (!v) fail(key, std::string("expected an integer, got ") + type_name(*n));
+  if (!in_range(static_cast<double>(*v), range)) {
+    std::ostringstream s;
+    s << "value " << *v << " is out of range; expected an integer" << describe_range(range).substr(8);
+    fail(key, s.str());
+  }
+  return *v;
+}
+
+long long ConfigTable::integer_or(std::string_view key, long long fallback, Range range) const {
+  if (!has(key)) {
+    mark_used(key);
+    return fallback;
+  }
+  return integer(key, range);
+}
+
+bool ConfigTable::boolean_or(std::string_view key, bool fallback) const {
+  const toml::node* n = lookup(*impl_, key);
+  if (!n) return fallback;
+  auto v = n->value_exact<bool>();
+  if (!v) fail(key, std::string("expected true or false, got ") + type_name(*n));
+  return *v;
+}
+
+std::string ConfigTable::string(std::string_view key) const {
+  const toml::node* n = lookup(*impl_, key);
+  if (!n) fail(key, "missing; expected a string");
+  auto v = n->value_exact<std::string>();
+  if (!v) fail(key, std::string("expected a string, got ") + type_name(*n));
+  return *v;
+}
+
+std::string ConfigTable::string_or(std::string_view key, std::string fallback) const {
+  if (!has(key)) {
+    mark_used(key);
+    return fallback;
+  }
+  return string(key);
+}
+
+std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
+                                   const std::vector<std::string>& allowed) const {
+  std::string v = string_or(key, std::move(fallback));
+  if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
+    std::string msg = "unknown value \"" + v + "\"; expected one of " + list;
+    if (auto m = closest_match(v, allowed)) msg += " (did you mean \"" + *m + "\"?)";
+    fail(key, msg);
+  }
+  return v;
+}
+
+std::vector<double> ConfigTable::numbers(std::string_view key, std::optional<size_t> size, Range range) const {
+  const toml::node* n = lookup(*impl_, key);
+  std::string expected = size ? "an array of " + std::to_string(*size) + " numbers" : std::string("an array of numbers");
+  if (!n) fail(key, "missing; expected " + expected);
+  const toml::array* arr = n->as_array();
+  if (!arr) fail(key, "expected " + expected + ", got " + type_name(*n));
+  if (size && arr->size() != *size) {
+    fail(key, "expected " + expected + ", got " + std::to_string(arr->size()));
+  }
+  std::vector<double> out;
+  for (size_t i = 0; i < arr->size(); ++i) {
+    auto v = as_number(*arr->get(i));
+    if (!v) fail(key, "element " + std::to_string(i + 1) + ": expected a number, got " + type_name(*arr->get(i)));
+    if (!in_range(*v, range)) {
+      std::ostringstream s;
+      s << "element " << i + 1 << " (" << *v << ") is out of range; expected " << describe_range(range);
+      fail(key, s.str());
+    }
+    out.push_back(*v);
+  }
+  return out;
+}
+
+std::vector<double> ConfigTable::numbers_or(std::string_view key, std::vector<double> fallback,
+                                            std::optional<size_t> size, Range range) const {
+  if (!has(key)) {
+    mark_used(key);
+    return fallback;
+  }
+  return numbers(key, size, range);
+}
+
+std::vector<std::vector<double>> ConfigTable::number_rows(std::string_view key, size_t row_size, Range range) const {
+  const toml::node* n = lookup(*impl_, key);
+  const std::string expected = "an array of [" + std::to_string(row_size) + " numbers] arrays";
+  if (!n) fail(key, "missing; expected " + expected);
+  const toml::array* arr = n->as_array();
+  if (!arr) fail(key, "expected " + expected + ", got " + type_name(*n));
+  std::vector<std::vector<double>> out;
+  for (size_t i = 0; i < arr->size(); ++i) {
+    const toml::array* row = arr->get(i)->as_array();
+    if (!row || row->size() != row_size) {
+      fail(key, "element " + std::to_string(i + 1) + ": expected an array of " + std::to_string(row_size) + " numbers");
+    }
+    std::vector<double> r;
+    for (size_t j = 0; j < row->size(); ++j) {
+      auto v = as_number(*row->get(j));
+      if (!v || !in_range(*v, range)) {
+        fail(key, "element " + std::to_string(i + 1) + "." + std::to_string(j + 1) + ": expected " +
+                      describe_range(range));
+      }
+      r.push_back(*v);
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::vector<std::string> ConfigTable::strings_or(std::string_view key, std::vector<std::string> fallback) const {
+  const toml::node* n = lookup(*impl_, key);
+  if (!n) return fallback;
+  const toml::array* arr = n->as_array();
+  if (!arr) fail(key, std::string("expected an array of strings, got ") + type_name(*n));
+  std::vector<std::string> out;
+  for (size_t i = 0; i < arr->size(); ++i) {
+    auto v = arr->get(i)->value_exact<std::string>();
+    if (!v) fail(key, "element " + std::to_string(i + 1) + ": expected a string");
+    out.push_back(*v);
+  }
+  return out;
+}
+
+ConfigTable ConfigTable::table(std::string_view key) const {
+  const toml::node* n = lookup(*impl_, key);
+  auto impl = std::make_shared<Impl>();
+  impl->root = impl_->root;
+  impl->source = impl_->source;
+  impl->path = impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key);
+  impl->line = impl_->line;
+  if (n) {
+    const toml::table* t = n->as_table();
+    if (!t) fail(key, std::string("expected a table, got ") + type_name(*n));
+    impl->table = t;
+    impl->line = static_cast<int>(t->source().begin.line);
+  }
+  return ConfigTable(impl);
+}
+
+std::vector<ConfigTable> ConfigTable::tables(std::string_view key) const {
+  const toml::node* n = lookup(*impl_, key);
+  std::vector<ConfigTable> out;
+  if (!n) return out;
+  const toml::array* arr = n->as_array();
+  if (!arr) fail(key, std::string("expected an array of tables, got ") + type_name(*n));
+  for (size_t i = 0; i < arr->size(); ++i) {
+    const toml::table* t = arr->get(i)->as_table();
+    if (!t) fail(key, "element " + std::to_string(i + 1) + ": expected a table");
+    auto impl = std::make_shared<Impl>();
+    impl->root = impl_->root;
+    impl->source = impl_->source;
+    impl->path = (impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key)) + "[" +
+                 std::to_string(i) + "]";
+    impl->table = t;
+    impl->line = static_cast<int>(t->source().begin.line);
+    out.push_back(ConfigTable(impl));
+  }
+  return out;
+}
+
+void ConfigTable::check_all_used() const {
+  if (!impl_->table) return;
+  std::vector<std::string> known(impl_->used->begin(), impl_->used->end());
+  for (const auto& k : keys()) {
+    if (impl_->used->count(k)) continue;
+    std::string msg = "unknown key";
+    if (impl_->path.empty()) msg += " at the top level";
+    else msg += " in [" + impl_->path + "]";
+    if (auto m = closest_match(k, known)) msg += " (did you mean '" + *m + "'?)";
+    else if (!known.empty()) {
+      std::string list;
+      for (const auto& a : known) list += (list.empty() ? "" : ", ") + a;
+      msg += "; known keys: " + list;
+    }
+    fail(k, msg);
+  }
+}
+
+}  // namespace gtrack

@@ -1,0 +1,121 @@
+// Aggregating per-frame errors: in view, out of view, lost, recovery.
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "gtrack/evaluation.hpp"
+
+namespace gtrack {
+
+namespace {
+
+ErrorStats stats(const std::vector<double>& v) {
+  ErrorStats s;
+  s.count = static_cast<int>(v.size());
+  if (v.empty()) return s;
+  double sum = 0, sq = 0;
+  for (double x : v) {
+    sum += x;
+    s.max = std::max(s.max, x);
+  }
+  s.mean = sum / v.size();
+  for (double x : v) sq += (x - s.mean) * (x - s.mean);
+  s.std = std::sqrt(sq / v.size());
+  return s;
+}
+
+// Share of the model inside the image, judged from its endpoints and palm
+// centre (when the truth file does not say).
+double in_view_from_sensor(const ArticulatedModel& model, const Sensor& sensor, const Eigen::VectorXd& h) {
+  auto pts = model.link_endpoints(h);
+  pts.push_back(h.head<3>());
+  const ImageSize size = sensor.image_size();
+  int inside = 0;
+  for (const auto& p : pts) {
+    const auto uv = sensor.project(p);
+    if (uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() < size.width && uv->y() < size.height) ++inside;
+  }
+  return static_cast<double>(inside) / pts.size();
+}
+
+}  // namespace
+
+void ErrorSet::add(const FrameErrors& e) {
+  const double v[9] = {e.position_um, e.inplane_um,  e.depth_um,    e.orientation_deg, e.joint_deg,
+                       e.endpoint_um, e.axis_deg[0], e.axis_deg[1], e.axis_deg[2]};
+  for (int i = 0; i < 9; ++i) sq_[i].push_back(v[i]);
+}
+
+void ErrorSet::finish() {
+  ErrorStats* out[9] = {&position_um, &position_inplane_um, &depth_um,    &orientation_deg, &joint_deg,
+                        &endpoint_um, &axis_deg[0],         &axis_deg[1], &axis_deg[2]};
+  for (int i = 0; i < 9; ++i) *out[i] = stats(sq_[i]);
+}
+
+Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const PoseTable& estimates,
+                    const EvalOptions& options, const Sensor* sensor) {
+  Evaluation ev;
+  ev.options = options;
+  std::map<int, const PoseRow*> by_frame;
+  for (const auto& r : estimates.rows) by_frame[r.frame] = &r;
+  const bool dims_match = estimates.fingers == model.fingers();
+
+  for (const PoseRow& t : truth.rows) {
+    FrameEvaluation fe;
+    fe.frame = t.frame;
+    auto iv = t.extra.find("in_view");
+    fe.in_view = iv != t.extra.end() ? iv->second : sensor ? in_view_from_sensor(model, *sensor, t.h) : 1.0;
+    fe.out_of_view = fe.in_view < options.out_of_view_below;
+    auto it = by_frame.find(t.frame);
+    fe.has_estimate = it != by_frame.end() && dims_match;
+    if (fe.has_estimate) {
+      fe.status = it->second->status;
+      fe.lost = fe.status == "lost" || !it->second->h.allFinite();
+    } else {
+      fe.lost = true;
+      ++ev.missing_frames;
+    }
+    if (fe.status == "search") ++ev.search_frames;
+    ++ev.frames;
+    (fe.out_of_view ? ev.out_of_view_frames : ev.in_view_frames)++;
+    if (fe.lost) {
+      ++ev.lost_frames;
+      if (!fe.out_of_view) ++ev.lost_in_view_frames;
+    } else {
+      fe.errors = compare_to_truth(model, t.h, it->second->h);
+      if (fe.out_of_view) {
+        ev.out_of_view.add(fe.errors);
+      } else {
+        ev.in_view.add(fe.errors);
+        ++ev.evaluated_frames;
+        if (fe.errors.endpoint_um > options.off_track_endpoint_um) ++ev.off_track_frames;
+      }
+    }
+    ev.per_frame.push_back(std::move(fe));
+  }
+  ev.in_view.finish();
+  ev.out_of_view.finish();
+
+  // Recovery: after each stretch out of view, frames until the estimate is
+  // back on the gripper.
+  const auto& pf = ev.per_frame;
+  for (size_t i = 1; i < pf.size(); ++i) {
+    if (!(pf[i - 1].out_of_view && !pf[i].out_of_view)) continue;
+    RecoveryEpisode ep;
+    ep.returned_at = pf[i].frame;
+    size_t j = i;
+    for (; j < pf.size() && !pf[j].out_of_view; ++j) {
+      const bool on = !pf[j].lost && pf[j].errors.endpoint_um <= options.off_track_endpoint_um;
+      if (on) {
+        ep.recovered = true;
+        break;
+      }
+    }
+    ep.frames_to_recover = static_cast<int>(j - i);
+    ev.frames_lost_after_return += ep.frames_to_recover;
+    ev.recovery.push_back(ep);
+  }
+  return ev;
+}
+
+}  // namespace gtrack

@@ -1,0 +1,122 @@
+// Reading and writing pose tables (ground truth and estimates).
+#include "gtrack/sequence_io.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "gtrack/error.hpp"
+#include "gtrack/parameter_space.hpp"
+
+namespace gtrack {
+
+namespace {
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) {
+    while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.pop_back();
+    while (!cell.empty() && cell.front() == ' ') cell.erase(cell.begin());
+    out.push_back(cell);
+  }
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+bool parse_number(const std::string& s, double& v) {
+  if (s == "nan" || s == "NaN") {
+    v = std::nan("");
+    return true;
+  }
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  return !s.empty() && ec == std::errc() && end == s.data() + s.size();
+}
+
+}  // namespace
+
+PoseTable read_pose_table(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot open");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(file.string() + ":1: empty file, expected a header line");
+  const auto header = split_csv(line);
+  std::map<std::string, int> col;
+  for (int i = 0; i < static_cast<int>(header.size()); ++i) col[header[i]] = i;
+
+  PoseTable table;
+  std::vector<std::string> names = {"frame", "x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
+  for (const auto& n : names) {
+    if (!col.count(n)) throw InputError(file.string() + ":1: missing column '" + n + "'");
+  }
+  while (col.count("q" + std::to_string(table.fingers + 1) + "_deg")) ++table.fingers;
+  if (table.fingers == 0) throw InputError(file.string() + ":1: no joint columns (q1_deg, q2_deg, ...)");
+  for (int f = 0; f < table.fingers; ++f) names.push_back("q" + std::to_string(f + 1) + "_deg");
+  std::vector<int> idx;
+  for (const auto& n : names) idx.push_back(col[n]);
+  const int status_col = col.count("status") ? col["status"] : -1;
+  std::vector<int> extra_idx;
+  for (int i = 0; i < static_cast<int>(header.size()); ++i) {
+    if (std::find(idx.begin(), idx.end(), i) != idx.end() || i == status_col) continue;
+    table.extra_columns.push_back(header[i]);
+    extra_idx.push_back(i);
+  }
+
+  int line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line == "\r") continue;
+    const auto cells = split_csv(line);
+    const auto where = file.string() + ":" + std::to_string(line_no) + ": ";
+    if (cells.size() < header.size()) {
+      throw InputError(where + "expected " + std::to_string(header.size()) + " columns, got " +
+                       std::to_string(cells.size()));
+    }
+    PoseRow row;
+    double v = 0;
+    if (!parse_number(cells[idx[0]], v) || v != std::floor(v)) {
+      throw InputError(where + "expected an integer frame index, got '" + cells[idx[0]] + "'");
+    }
+    row.frame = static_cast<int>(v);
+    row.h.resize(kPoseDims + table.fingers);
+    for (int d = 0; d < row.h.size(); ++d) {
+      if (!parse_number(cells[idx[d + 1]], row.h[d])) {
+        throw InputError(where + "expected a number for '" + names[d + 1] + "', got '" + cells[idx[d + 1]] + "'");
+      }
+    }
+    if (status_col >= 0) row.status = cells[status_col];
+    for (size_t e = 0; e < extra_idx.size(); ++e) {
+      if (parse_number(cells[extra_idx[e]], v)) row.extra[table.extra_columns[e]] = v;
+    }
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+std::string pose_table_header(int fingers, const std::vector<std::string>& extra) {
+  std::string s = "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg";
+  for (int f = 0; f < fingers; ++f) s += ",q" + std::to_string(f + 1) + "_deg";
+  for (const auto& e : extra) s += "," + e;
+  return s;
+}
+
+std::string pose_table_row(int frame, const Eigen::VectorXd& h, const std::vector<double>& extra) {
+  std::string s = std::to_string(frame);
+  char buf[64];
+  for (int d = 0; d < h.size(); ++d) {
+    // Positions in mm need 6 decimals for sub-micrometre truth; angles 5.
+    std::snprintf(buf, sizeof buf, d < 3 ? ",%.6f" : ",%.5f", h[d]);
+    s += buf;
+  }
+  for (double e : extra) {
+    std::snprintf(buf, sizeof buf, ",%.4f", e);
+    s += buf;
+  }
+  return s;
+}
+
+}  // namespace gtrack

@@ -1,0 +1,438 @@
+// GlRenderer: model, projection and observation on the GPU; a generation per
+// draw + dispatch; counts back through one fence.
+#include "gl/gl_renderer.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "gl/shader_program.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
+
+namespace gtrack {
+
+namespace gl {
+
+namespace {
+
+constexpr int kLayerBits = 32;         // hypotheses per R32UI layer
+constexpr int kCountGroupWidth = 32;   // columns per count workgroup
+constexpr int kCountRows = 128;        // rows per count invocation (<= 255, see count.comp)
+constexpr int kMaxClipPlanes = 4;
+
+// Binding points shared with the shaders.
+enum Binding : GLuint { kMesh = 0, kFingers = 1, kLinks = 2, kHypotheses = 3, kBoxes = 4, kCounts = 5 };
+
+static_assert(sizeof(ModelVertex) == 16, "ModelVertex must match the std430 MeshVertex of pose.glsl");
+
+int layers_for(int hypotheses) { return (hypotheses + kLayerBits - 1) / kLayerBits; }
+
+GLuint make_buffer(const Api& gl, GLsizeiptr bytes, const void* data, GLbitfield flags) {
+  GLuint b = 0;
+  gl.CreateBuffers(1, &b);
+  gl.NamedBufferStorage(b, std::max<GLsizeiptr>(bytes, 16), data, flags);
+  return b;
+}
+
+void delete_buffer(const Api& gl, GLuint& b) {
+  if (b != 0) gl.DeleteBuffers(1, &b);
+  b = 0;
+}
+
+std::string prelude(const std::string& layer_extension) {
+  std::string p = "#version 450 core\n";
+  if (!layer_extension.empty()) p += "#extension " + layer_extension + " : require\n";
+  p += "#define MAX_CLIP_PLANES " + std::to_string(kMaxClipPlanes) + "\n";
+  p += "#define COUNT_GROUP_WIDTH " + std::to_string(kCountGroupWidth) + "\n";
+  p += "#define COUNT_ROWS " + std::to_string(kCountRows) + "\n";
+  return p;
+}
+
+}  // namespace
+
+GlRenderer::GlRenderer(const RenderOptions& options)
+    : context_(EglContext::open(ContextRequest{options.egl_device, options.threads})) {
+  gl_.load();
+
+  GLint major = 0, minor = 0;
+  gl_.GetIntegerv(GL_MAJOR_VERSION, &major);
+  gl_.GetIntegerv(GL_MINOR_VERSION, &minor);
+  const std::string who = context_.gl_renderer() + " on " + context_.display_label();
+  if (major * 10 + minor < 45) {
+    throw Error("gl backend: " + who + " offers OpenGL " + std::to_string(major) + "." + std::to_string(minor) +
+                ", 4.5 is needed");
+  }
+  GLint vertex_buffers = 0, clip_distances = 0;
+  gl_.GetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &vertex_buffers);
+  gl_.GetIntegerv(GL_MAX_CLIP_DISTANCES, &clip_distances);
+  if (vertex_buffers < 4) {
+    throw Error("gl backend: " + who + " allows " + std::to_string(vertex_buffers) +
+                " storage buffers in a vertex shader, 4 are needed");
+  }
+  max_clip_planes_ = std::min(kMaxClipPlanes, static_cast<int>(clip_distances));
+  // gl_Layer from the vertex shader puts every layer in the same draw.
+  std::string layer_extension;
+  if (gl_.has_extension("GL_ARB_shader_viewport_layer_array")) {
+    layer_extension = "GL_ARB_shader_viewport_layer_array";
+  } else if (gl_.has_extension("GL_AMD_vertex_shader_layer")) {
+    layer_extension = "GL_AMD_vertex_shader_layer";
+  } else {
+    throw Error("gl backend: " + who +
+                " has neither GL_ARB_shader_viewport_layer_array nor GL_AMD_vertex_shader_layer (gl_Layer in a "
+                "vertex shader)");
+  }
+
+  const std::string head = prelude(layer_extension);
+  draw_program_ = build_program(gl_, head, {{GL_VERTEX_SHADER, {"pose.glsl", "hypotheses.vert"}},
+                                            {GL_FRAGMENT_SHADER, {"hypotheses.frag"}}});
+  try {
+    count_program_ = build_program(gl_, head, {{GL_COMPUTE_SHADER, {"count.comp"}}});
+  } catch (...) {
+    gl_.DeleteProgram(draw_program_);
+    throw;
+  }
+  u_clip_ = gl_.GetUniformLocation(draw_program_, "u_clip");
+  u_planes_ = gl_.GetUniformLocation(draw_program_, "u_planes");
+  u_draw_dims_ = gl_.GetUniformLocation(draw_program_, "u_dims");
+  u_draw_max_links_ = gl_.GetUniformLocation(draw_program_, "u_max_links");
+  u_hypotheses_ = gl_.GetUniformLocation(count_program_, "u_hypotheses");
+
+  gl_.CreateVertexArrays(1, &vao_);
+  gl_.BindVertexArray(vao_);  // core profile draws need one, even with no attributes
+  gl_.CreateFramebuffers(1, &framebuffer_);
+  gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer_);
+
+  // Window y = image row: framebuffer row 0 is image row 0, and "top-left"
+  // in the fill rule means the image's top-left.
+  gl_.ClipControl(GL_UPPER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  gl_.Enable(GL_COLOR_LOGIC_OP);
+  gl_.LogicOp(GL_OR);
+  gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.check("setting up the context");
+  logger().info("gl backend: {} ({}), on {}", context_.gl_renderer(), context_.gl_version(),
+                 context_.display_label());
+}
+
+GlRenderer::~GlRenderer() { release(); }
+
+void GlRenderer::release() noexcept {
+  try {
+    context_.make_current();
+  } catch (...) {
+    return;  // the context goes with its objects
+  }
+  if (fence_ != nullptr) {
+    gl_.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, 10'000'000'000ull);
+    gl_.DeleteSync(fence_);
+    fence_ = nullptr;
+  }
+  if (readback_ != nullptr) gl_.UnmapNamedBuffer(readback_buffer_);
+  readback_ = nullptr;
+  for (GLuint* b : {&mesh_buffer_, &finger_buffer_, &link_buffer_, &hypothesis_buffer_, &box_buffer_,
+                    &count_buffer_, &readback_buffer_}) {
+    delete_buffer(gl_, *b);
+  }
+  for (GLuint* t : {&target_, &observation_}) {
+    if (*t != 0) gl_.DeleteTextures(1, t);
+    *t = 0;
+  }
+  if (framebuffer_ != 0) gl_.DeleteFramebuffers(1, &framebuffer_);
+  if (vao_ != 0) gl_.DeleteVertexArrays(1, &vao_);
+  if (draw_program_ != 0) gl_.DeleteProgram(draw_program_);
+  if (count_program_ != 0) gl_.DeleteProgram(count_program_);
+  framebuffer_ = vao_ = draw_program_ = count_program_ = 0;
+}
+
+void GlRenderer::set_model(const ArticulatedModel& model) {
+  context_.make_current();
+  wait_for_fence();
+  const auto& mesh = model.mesh();
+  if (mesh.empty()) throw Error("gl backend: the gripper model has no triangles");
+  const int fingers = model.fingers();
+  const int max_links = std::max(1, model.max_links());
+  std::vector<float> finger_data, link_data(static_cast<size_t>(fingers * max_links), 0.0f);
+  for (int f = 0; f < fingers; ++f) {
+    const FingerShape& shape = model.geometry().fingers[static_cast<size_t>(f)];
+    const double phi = shape.direction_deg * (3.14159265358979323846 / 180.0);
+    finger_data.insert(finger_data.end(), {float(shape.base_mm.x()), float(shape.base_mm.y()),
+                                           float(std::cos(phi)), float(std::sin(phi))});
+    for (size_t j = 0; j < shape.links.size(); ++j) {
+      link_data[static_cast<size_t>(f * max_links) + j] = float(shape.links[j].length_mm);
+    }
+  }
+  for (GLuint* b : {&mesh_buffer_, &finger_buffer_, &link_buffer_}) delete_buffer(gl_, *b);
+  if (model.dims() != dims_) hypothesis_capacity_ = 0;  // the hypothesis buffer is sized in floats
+  mesh_buffer_ = make_buffer(gl_, GLsizeiptr(mesh.size() * sizeof(ModelVertex)), mesh.data(), 0);
+  finger_buffer_ = make_buffer(gl_, GLsizeiptr(finger_data.size() * sizeof(float)), finger_data.data(), 0);
+  link_buffer_ = make_buffer(gl_, GLsizeiptr(link_data.size() * sizeof(float)), link_data.data(), 0);
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kMesh, mesh_buffer_);
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kFingers, finger_buffer_);
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kLinks, link_buffer_);
+
+  dims_ = model.dims();
+  vertices_ = static_cast<int>(mesh.size());
+  reach_mm_ = model_reach_mm(model);
+  gl_.ProgramUniform1i(draw_program_, u_draw_dims_, dims_);
+  gl_.ProgramUniform1i(draw_program_, u_draw_max_links_, max_links);
+  gl_.check("uploading the model");
+}
+
+void GlRenderer::set_projection(const Projection& projection, double scale) {
+  context_.make_current();
+  wait_for_fence();
+  const Projection p = scaled_projection(projection, scale);
+  if (static_cast<int>(p.clip_planes.size()) > max_clip_planes_) {
+    throw Error("gl backend: the projection has " + std::to_string(p.clip_planes.size()) +
+                " clip planes, at most " + std::to_string(max_clip_planes_) + " are supported");
+  }
+  const int w = p.size.width, h = p.size.height;
+  GLint max_size = 0;
+  gl_.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (w > max_size || h > max_size) {
+    throw Error("gl backend: render size " + std::to_string(w) + "x" + std::to_string(h) + " exceeds " +
+                std::to_string(max_size) + " pixels a side");
+  }
+
+  // Clip coordinates from (u w, v w, w): x_ndc = 2u/W - 1 and, with the
+  // upper-left clip origin, y_ndc = 1 - 2v/H. z = 0 keeps only w >= 0.
+  const Eigen::Matrix<double, 3, 4>& m = p.world_to_image;
+  Eigen::Matrix4d clip = Eigen::Matrix4d::Zero();
+  clip.row(0) = (2.0 / w) * m.row(0) - m.row(2);
+  clip.row(1) = m.row(2) - (2.0 / h) * m.row(1);
+  clip.row(3) = m.row(2);
+  const Eigen::Matrix4f clip_f = clip.cast<float>();
+  gl_.ProgramUniformMatrix4fv(draw_program_, u_clip_, 1, GL_FALSE, clip_f.data());
+
+  float planes[kMaxClipPlanes * 4];
+  for (int i = 0; i < kMaxClipPlanes; ++i) {
+    // Unused planes keep everything (0 x + 1 >= 0) and stay disabled.
+    Eigen::Vector4d pl(0, 0, 0, 1);
+    if (i < static_cast<int>(p.clip_planes.size())) pl = p.clip_planes[static_cast<size_t>(i)];
+    for (int k = 0; k < 4; ++k) planes[4 * i + k] = float(pl[k]);
+    if (i < max_clip_planes_) {
+      if (i < static_cast<int>(p.clip_planes.size())) {
+        gl_.Enable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(i));
+      } else {
+        gl_.Disable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(i));
+      }
+    }
+  }
+  gl_.ProgramUniform4fv(draw_program_, u_planes_, kMaxClipPlanes, planes);
+
+  const bool resized = p.size.width != projection_.size.width || p.size.height != projection_.size.height;
+  projection_ = p;
+  has_projection_ = true;
+  gl_.Viewport(0, 0, w, h);
+  if (resized || observation_ == 0) {
+    if (target_ != 0) gl_.DeleteTextures(1, &target_);
+    target_ = 0;
+    const int layers = layer_capacity_;
+    layer_capacity_ = 0;
+    reserve_layers(std::max(1, layers));
+    if (observation_ != 0) gl_.DeleteTextures(1, &observation_);
+    gl_.CreateTextures(GL_TEXTURE_2D, 1, &observation_);
+    gl_.TextureStorage2D(observation_, 1, GL_R8UI, w, h);
+    // Integer textures are incomplete (and read as 0) with linear filtering.
+    gl_.TextureParameteri(observation_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl_.TextureParameteri(observation_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    const GLuint zero = 0;
+    gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
+    gl_.BindTextureUnit(1, observation_);
+    observation_count_ = 0;
+  }
+  gl_.check("setting the projection");
+}
+
+void GlRenderer::set_observation(const cv::Mat& mask) {
+  if (!has_projection_) throw Error("gl backend: set_observation() before set_projection()");
+  const ImageSize s = projection_.size;
+  if (mask.type() != CV_8UC1 || mask.cols != s.width || mask.rows != s.height) {
+    throw Error("gl backend: the observation must be CV_8U at the render size " + std::to_string(s.width) + "x" +
+                std::to_string(s.height) + ", got " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
+                " of type " + std::to_string(mask.type()));
+  }
+  context_.make_current();
+  wait_for_fence();
+  const cv::Mat packed = mask.isContinuous() ? mask : mask.clone();
+  gl_.TextureSubImage2D(observation_, 0, 0, 0, s.width, s.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE, packed.data);
+  observation_count_ = static_cast<std::uint64_t>(cv::countNonZero(packed));
+  gl_.check("uploading the observation");
+}
+
+void GlRenderer::require_ready(const char* what, Eigen::Index rows) const {
+  if (vertices_ == 0) throw Error(std::string("gl backend: ") + what + " before set_model()");
+  if (!has_projection_) throw Error(std::string("gl backend: ") + what + " before set_projection()");
+  if (rows != dims_) {
+    throw Error(std::string("gl backend: ") + what + ": a hypothesis has " + std::to_string(rows) +
+                " values, the model needs " + std::to_string(dims_));
+  }
+}
+
+void GlRenderer::reserve_hypotheses(int count) {
+  if (count <= hypothesis_capacity_) return;
+  const int capacity = std::max(count, 2 * hypothesis_capacity_);
+  if (readback_ != nullptr) gl_.UnmapNamedBuffer(readback_buffer_);
+  readback_ = nullptr;
+  for (GLuint* b : {&hypothesis_buffer_, &count_buffer_, &readback_buffer_}) delete_buffer(gl_, *b);
+  hypothesis_buffer_ =
+      make_buffer(gl_, GLsizeiptr(capacity) * dims_ * GLsizeiptr(sizeof(float)), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  // The atomics hit a buffer the GPU owns; only the final 8 N bytes are
+  // copied into host-visible memory, mapped once for good.
+  const GLsizeiptr count_bytes = GLsizeiptr(capacity) * 2 * GLsizeiptr(sizeof(std::uint32_t));
+  count_buffer_ = make_buffer(gl_, count_bytes, nullptr, 0);
+  const GLbitfield map = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+  readback_buffer_ = make_buffer(gl_, count_bytes, nullptr, map | GL_CLIENT_STORAGE_BIT);
+  readback_ = static_cast<const std::uint32_t*>(gl_.MapNamedBufferRange(readback_buffer_, 0, count_bytes, map));
+  if (readback_ == nullptr) throw Error("gl backend: cannot map the count buffer");
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kHypotheses, hypothesis_buffer_);
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kCounts, count_buffer_);
+  hypothesis_capacity_ = capacity;
+}
+
+void GlRenderer::reserve_layers(int layers) {
+  if (layers == layer_capacity_ && target_ != 0) return;
+  GLint max_layers = 0;
+  gl_.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  if (layers > max_layers) {
+    throw Error("gl backend: " + std::to_string(layers * kLayerBits) + " hypotheses need " + std::to_string(layers) +
+                " layers, the driver allows " + std::to_string(max_layers));
+  }
+  if (target_ != 0) gl_.DeleteTextures(1, &target_);
+  gl_.CreateTextures(GL_TEXTURE_2D_ARRAY, 1, &target_);
+  gl_.TextureStorage3D(target_, 1, GL_R32UI, projection_.size.width, projection_.size.height, layers);
+  gl_.TextureParameteri(target_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl_.TextureParameteri(target_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl_.NamedFramebufferTexture(framebuffer_, GL_COLOR_ATTACHMENT0, target_, 0);  // layered
+  gl_.NamedFramebufferDrawBuffer(framebuffer_, GL_COLOR_ATTACHMENT0);
+  const GLenum status = gl_.CheckNamedFramebufferStatus(framebuffer_, GL_DRAW_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw Error("gl backend: the layered R32UI render target is incomplete (status " + std::to_string(status) + ")");
+  }
+  gl_.BindTextureUnit(0, target_);
+  delete_buffer(gl_, box_buffer_);
+  box_buffer_ = make_buffer(gl_, GLsizeiptr(layers) * GLsizeiptr(sizeof(PixelBox)), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBoxes, box_buffer_);
+  layer_capacity_ = layers;
+}
+
+void GlRenderer::upload_hypotheses(const double* data, int count) {
+  staging_.resize(static_cast<size_t>(count) * static_cast<size_t>(dims_));
+  std::transform(data, data + staging_.size(), staging_.begin(), [](double v) { return float(v); });
+  gl_.NamedBufferSubData(hypothesis_buffer_, 0, GLsizeiptr(staging_.size() * sizeof(float)), staging_.data());
+}
+
+void GlRenderer::draw(int count) {
+  // A framebuffer clear is recorded, not executed: llvmpipe applies it per
+  // tile as it rasterises (measured ~1.5x faster per generation than
+  // glClearTexSubImage), and GPUs clear fast either way. It covers every
+  // layer of the target, which is why the target has exactly the layers of
+  // the last batch.
+  const GLuint zero[4] = {0, 0, 0, 0};
+  gl_.ClearNamedFramebufferuiv(framebuffer_, GL_COLOR, 0, zero);
+  gl_.UseProgram(draw_program_);
+  gl_.DrawArraysInstanced(GL_TRIANGLES, 0, vertices_, count);
+}
+
+void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
+  require_ready("submit()", hypotheses.rows());
+  if (pending_ >= 0) throw Error("gl backend: submit() called again before finish()");
+  context_.make_current();
+  const int n = static_cast<int>(hypotheses.cols());
+  if (n == 0) {
+    pending_ = 0;
+    return;
+  }
+  reserve_hypotheses(n);
+  const int layers = layers_for(n);
+  reserve_layers(layers);
+  upload_hypotheses(hypotheses.data(), n);
+
+  static_assert(sizeof(PixelBox) == 4 * sizeof(GLint), "PixelBox must match the ivec4 boxes of count.comp");
+  boxes_.assign(static_cast<size_t>(layers), PixelBox{});
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d centre = hypotheses.col(i).head<3>();
+    boxes_[static_cast<size_t>(i / kLayerBits)].unite(hypothesis_box(projection_, centre, reach_mm_));
+  }
+  int max_w = 0, max_h = 0;
+  for (const PixelBox& b : boxes_) {
+    max_w = std::max(max_w, b.width());
+    max_h = std::max(max_h, b.height());
+  }
+  gl_.NamedBufferSubData(box_buffer_, 0, GLsizeiptr(boxes_.size() * sizeof(PixelBox)), boxes_.data());
+
+  const GLsizeiptr count_bytes = GLsizeiptr(n) * 2 * GLsizeiptr(sizeof(std::uint32_t));
+  gl_.ClearNamedBufferSubData(count_buffer_, GL_R32UI, 0, count_bytes, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  draw(n);
+  if (max_w > 0 && max_h > 0) {
+    gl_.UseProgram(count_program_);
+    gl_.ProgramUniform1i(count_program_, u_hypotheses_, n);
+    gl_.DispatchCompute(GLuint((max_w + kCountGroupWidth - 1) / kCountGroupWidth),
+                        GLuint((max_h + kCountRows - 1) / kCountRows), GLuint(layers));
+  }
+  gl_.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  gl_.CopyNamedBufferSubData(count_buffer_, readback_buffer_, 0, 0, count_bytes);
+  fence_ = gl_.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  // Start the work now: the caller computes its other cost terms meanwhile.
+  gl_.Flush();
+  pending_ = n;
+}
+
+void GlRenderer::wait_for_fence() {
+  if (fence_ == nullptr) return;
+  for (;;) {
+    const GLenum r = gl_.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000ull);
+    if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) break;
+    if (r == GL_WAIT_FAILED) {
+      gl_.DeleteSync(fence_);
+      fence_ = nullptr;
+      gl_.check("waiting for the GPU");
+      throw Error("gl backend: waiting for the GPU failed");
+    }
+  }
+  gl_.DeleteSync(fence_);
+  fence_ = nullptr;
+}
+
+void GlRenderer::finish(std::vector<PairCounts>& out) {
+  if (pending_ < 0) throw Error("gl backend: finish() without submit()");
+  context_.make_current();
+  wait_for_fence();
+  const int n = pending_;
+  pending_ = -1;
+  out.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    out[static_cast<size_t>(i)] = PairCounts{readback_[2 * i], readback_[2 * i + 1]};
+  }
+}
+
+cv::Mat GlRenderer::render_mask(const Eigen::VectorXd& hypothesis) {
+  require_ready("render_mask()", hypothesis.size());
+  context_.make_current();
+  // Commands run in order: a batch in flight keeps its counts, its masks are
+  // simply drawn over once it is done with them.
+  reserve_hypotheses(1);
+  upload_hypotheses(hypothesis.data(), 1);
+  draw(1);
+  const int w = projection_.size.width, h = projection_.size.height;
+  std::vector<std::uint32_t> bits(static_cast<size_t>(w) * static_cast<size_t>(h));
+  gl_.GetTextureSubImage(target_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                         GLsizei(bits.size() * sizeof(std::uint32_t)), bits.data());
+  gl_.check("reading a mask back");
+  cv::Mat mask(h, w, CV_8UC1);
+  for (int y = 0; y < h; ++y) {
+    auto* row = mask.ptr<std::uint8_t>(y);
+    const std::uint32_t* src = bits.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
+    for (int x = 0; x < w; ++x) row[x] = (src[x] & 1u) ? 255 : 0;
+  }
+  return mask;
+}
+
+}  // namespace gl
+
+std::unique_ptr<Renderer> make_gl_renderer(const RenderOptions& options) {
+  return std::make_unique<gl::GlRenderer>(options);
+}
+
+}  // namespace gtrack

@@ -1,0 +1,84 @@
+// The gl backend of Renderer: OpenGL 4.5 core through headless EGL.
+//
+// One generation of N hypotheses costs, on the GPU side: one buffer upload of
+// the parameter vectors (N x dims floats) and of the per-layer count boxes,
+// one instanced draw (instance = hypothesis; 32 hypotheses share an R32UI
+// layer, each its own bit, merged with the OR logic op), one compute dispatch
+// that reduces |O & P| and |P| per hypothesis, one 8 N-byte copy into a
+// persistently mapped buffer and one fence. submit() issues all of it and
+// returns; finish() waits on the fence once and reads the counts from the
+// mapping. The model, the projection and the observation stay on the GPU
+// until they change.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gl/egl_context.hpp"
+#include "gl/gl_api.hpp"
+#include "gl/hypothesis_bounds.hpp"
+#include "gtrack/renderer.hpp"
+
+namespace gtrack::gl {
+
+class GlRenderer final : public Renderer {
+ public:
+  explicit GlRenderer(const RenderOptions& options);
+  ~GlRenderer() override;
+  GlRenderer(const GlRenderer&) = delete;
+  GlRenderer& operator=(const GlRenderer&) = delete;
+
+  std::string name() const override { return "gl"; }
+  void set_model(const ArticulatedModel& model) override;
+  void set_projection(const Projection& projection, double scale) override;
+  ImageSize render_size() const override { return projection_.size; }
+  void set_observation(const cv::Mat& mask) override;
+  std::uint64_t observation_count() const override { return observation_count_; }
+
+  void submit(const Eigen::MatrixXd& hypotheses) override;
+  void finish(std::vector<PairCounts>& out) override;
+
+  cv::Mat render_mask(const Eigen::VectorXd& hypothesis) override;
+
+ private:
+  void require_ready(const char* what, Eigen::Index rows) const;
+  void reserve_hypotheses(int count);
+  void reserve_layers(int layers);
+  void upload_hypotheses(const double* data, int count);
+  // Clears the target and draws hypotheses 0 .. count-1 into it.
+  void draw(int count);
+  void wait_for_fence();
+  void release() noexcept;
+
+  EglContext context_;
+  Api gl_;
+
+  GLuint draw_program_ = 0;
+  GLuint count_program_ = 0;
+  GLint u_clip_ = -1, u_planes_ = -1, u_draw_dims_ = -1, u_draw_max_links_ = -1, u_hypotheses_ = -1;
+  GLuint vao_ = 0;
+  GLuint framebuffer_ = 0;
+  GLuint target_ = 0;       // R32UI 2D array, one layer per 32 hypotheses
+  GLuint observation_ = 0;  // R8UI
+  GLuint mesh_buffer_ = 0, finger_buffer_ = 0, link_buffer_ = 0;
+  GLuint hypothesis_buffer_ = 0, box_buffer_ = 0, count_buffer_ = 0, readback_buffer_ = 0;
+  const std::uint32_t* readback_ = nullptr;  // persistent, coherent mapping of readback_buffer_
+
+  int hypothesis_capacity_ = 0;
+  int layer_capacity_ = 0;  // layers of target_: those of the last batch
+  int max_clip_planes_ = 0;
+
+  int dims_ = 0;
+  int vertices_ = 0;
+  double reach_mm_ = 0;
+  Projection projection_;  // at render size
+  bool has_projection_ = false;
+  std::uint64_t observation_count_ = 0;
+
+  GLsync fence_ = nullptr;
+  int pending_ = -1;  // hypotheses of the batch in flight, -1 when none
+  std::vector<float> staging_;
+  std::vector<PixelBox> boxes_;
+};
+
+}  // namespace gtrack::gl

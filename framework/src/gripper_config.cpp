@@ -1,0 +1,33 @@
+// Radial gripper geometry from a [gripper] table with built-in defaults.
+#include "gtrack/gripper_config.hpp"
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDefaults d) {
+  RadialGripperSpec spec = d.spec;
+  spec.palm_circumradius_mm = t.number_or("palm_circumradius_mm", spec.palm_circumradius_mm, Range::positive());
+  std::vector<double> lengths;
+  for (const auto& l : spec.links) lengths.push_back(l.length_mm);
+  lengths = t.numbers_or("link_lengths_mm", lengths, std::nullopt, Range::positive());
+  if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
+  const bool lengths_changed = lengths.size() != d.widths_mm.size() - 1;
+  std::vector<double> widths = t.numbers_or("link_widths_mm", lengths_changed ? std::vector<double>{} : d.widths_mm,
+                                            lengths.size() + 1, Range::non_negative());
+  spec.links.clear();
+  for (size_t j = 0; j < lengths.size(); ++j) spec.links.push_back({lengths[j], widths[j], widths[j + 1]});
+
+  GripperGeometry g = make_radial_gripper(spec);
+  g.joint_min_deg = t.number_or("joint_min_deg", d.joint_min_deg, Range::closed(-180, 180));
+  g.joint_max_deg = t.number_or("joint_max_deg", d.joint_max_deg, Range::closed(-180, 180));
+  if (!(g.joint_min_deg < g.joint_max_deg)) t.fail("joint_max_deg", "must be greater than joint_min_deg");
+  g.collision.max_difference_deg =
+      t.number_or("max_adjacent_difference_deg", d.max_adjacent_difference_deg, Range::positive());
+  g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", d.max_adjacent_sum_deg, Range::positive());
+  g.unfolded_deg = t.number_or("unfolded_deg", d.unfolded_deg);
+  g.folded_deg = t.number_or("folded_deg", d.folded_deg);
+  return g;
+}
+
+}  // namespace gtrack

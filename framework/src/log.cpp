@@ -1,0 +1,28 @@
+// The one logger of the process, shared with every plugin.
+#include "gtrack/log.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+spdlog::logger& logger() {
+  static std::shared_ptr<spdlog::logger> log = [] {
+    auto l = spdlog::stderr_color_mt("gtrack");
+    l->set_pattern("[%l] %v");
+    return l;
+  }();
+  return *log;
+}
+
+void set_log_level(std::string_view level) {
+  auto lvl = spdlog::level::from_str(std::string(level));
+  if (lvl == spdlog::level::off && level != "off") {
+    throw Error("--log-level: unknown level '" + std::string(level) +
+                "'; expected one of trace, debug, info, warn, error, critical, off");
+  }
+  logger().set_level(lvl);
+}
+
+}  // namespace gtrack

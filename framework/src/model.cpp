@@ -1,0 +1,264 @@
+// ArticulatedModel: the mesh, posing, K(H) and rotational symmetry.
+#include "gtrack/model.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+namespace {
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+void add_triangle(std::vector<ModelVertex>& m, ModelVertex a, ModelVertex b, ModelVertex c) {
+  m.push_back(a);
+  m.push_back(b);
+  m.push_back(c);
+}
+}  // namespace
+
+Eigen::Matrix3d rotation_from_euler_deg(double rx, double ry, double rz) {
+  return (Eigen::AngleAxisd(rz * kDeg, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(ry * kDeg, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rx * kDeg, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+Eigen::Vector3d euler_deg_from_rotation(const Eigen::Matrix3d& r) {
+  // R = Rz Ry Rx: r(2,0) = -sin(ry).
+  const double sy = std::clamp(-r(2, 0), -1.0, 1.0);
+  const double ry = std::asin(sy);
+  double rx, rz;
+  if (std::abs(sy) < 1.0 - 1e-9) {
+    rx = std::atan2(r(2, 1), r(2, 2));
+    rz = std::atan2(r(1, 0), r(0, 0));
+  } else {  // gimbal lock: put everything in rz
+    rx = 0;
+    rz = std::atan2(-r(0, 1), r(1, 1));
+  }
+  return Eigen::Vector3d(rx, ry, rz) / kDeg;
+}
+
+ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) {
+  const auto& G = geometry_;
+  if (G.palm_mm.size() < 3) throw Error("gripper '" + G.name + "': the palm polygon needs at least 3 points");
+  if (G.fingers.empty()) throw Error("gripper '" + G.name + "': it has no fingers");
+  if (!(G.joint_min_deg < G.joint_max_deg)) throw Error("gripper '" + G.name + "': joint_min must be below joint_max");
+  if (G.symmetry_order < 1) throw Error("gripper '" + G.name + "': symmetry order must be >= 1");
+  for (size_t f = 0; f < G.fingers.size(); ++f) {
+    if (G.fingers[f].links.empty()) throw Error("gripper '" + G.name + "': finger " + std::to_string(f + 1) + " has no links");
+    for (const auto& l : G.fingers[f].links) {
+      if (!(l.length_mm > 0) || l.width_start_mm < 0 || l.width_end_mm < 0 || (l.width_start_mm <= 0 && l.width_end_mm <= 0)) {
+        throw Error("gripper '" + G.name + "': finger " + std::to_string(f + 1) +
+                    " has a link with non-positive length or width");
+      }
+    }
+  }
+  for (auto [a, b] : G.collision.adjacent) {
+    if (a < 0 || b < 0 || a >= fingers() || b >= fingers())
+      throw Error("gripper '" + G.name + "': adjacency names a finger that does not exist");
+  }
+
+  // Palm: a fan over the convex polygon.
+  for (size_t i = 1; i + 1 < G.palm_mm.size(); ++i) {
+    auto pv = [](const Eigen::Vector2d& p) { return ModelVertex{float(p.x()), float(p.y()), -1, 0}; };
+    add_triangle(mesh_, pv(G.palm_mm[0]), pv(G.palm_mm[i]), pv(G.palm_mm[i + 1]));
+  }
+  // Links: a trapezoid is two triangles, a pointed link one.
+  for (int f = 0; f < fingers(); ++f) {
+    const auto& links = G.fingers[f].links;
+    for (int j = 0; j < static_cast<int>(links.size()); ++j) {
+      const auto& l = links[j];
+      const float L = float(l.length_mm), w0 = float(l.width_start_mm / 2), w1 = float(l.width_end_mm / 2);
+      ModelVertex p0{0, -w0, f, j}, p1{L, -w1, f, j}, p2{L, w1, f, j}, p3{0, w0, f, j};
+      if (w1 <= 0) {
+        add_triangle(mesh_, p0, ModelVertex{L, 0, f, j}, p3);
+      } else if (w0 <= 0) {
+        add_triangle(mesh_, ModelVertex{0, 0, f, j}, p1, p2);
+      } else {
+        add_triangle(mesh_, p0, p1, p2);
+        add_triangle(mesh_, p0, p2, p3);
+      }
+    }
+  }
+
+  // One symmetry step rotates by 360/order: finger f lands where finger
+  // shift[f] was. Found by matching base directions.
+  finger_shift_.resize(fingers());
+  const double step = 360.0 / G.symmetry_order;
+  for (int f = 0; f < fingers(); ++f) {
+    const double target = G.fingers[f].direction_deg + step;
+    int best = f;
+    double best_d = 1e9;
+    for (int g2 = 0; g2 < fingers(); ++g2) {
+      double d = std::fmod(std::abs(G.fingers[g2].direction_deg - target), 360.0);
+      d = std::min(d, 360.0 - d);
+      if (d < best_d) {
+        best_d = d;
+        best = g2;
+      }
+    }
+    finger_shift_[f] = best;
+  }
+}
+
+int ArticulatedModel::max_links() const {
+  size_t m = 0;
+  for (const auto& f : geometry_.fingers) m = std::max(m, f.links.size());
+  return static_cast<int>(m);
+}
+
+void ArticulatedModel::pose_model(std::span<const double> joints, std::vector<Eigen::Vector3d>& out) const {
+  const auto& G = geometry_;
+  // Hinge points and link angles per finger, once per call.
+  struct Link {
+    double hr, hz, c, s;
+  };
+  thread_local std::vector<Link> links;
+  thread_local std::vector<int> first;
+  links.clear();
+  first.assign(G.fingers.size() + 1, 0);
+  for (size_t f = 0; f < G.fingers.size(); ++f) {
+    first[f] = static_cast<int>(links.size());
+    const double q = joints[f] * kDeg;
+    double hr = 0, hz = 0;
+    for (size_t j = 0; j < G.fingers[f].links.size(); ++j) {
+      const double th = double(j + 1) * q;
+      const double c = std::cos(th), s = std::sin(th);
+      links.push_back({hr, hz, c, s});
+      hr += G.fingers[f].links[j].length_mm * c;
+      hz += G.fingers[f].links[j].length_mm * s;
+    }
+  }
+  out.resize(mesh_.size());
+  for (size_t i = 0; i < mesh_.size(); ++i) {
+    const ModelVertex& v = mesh_[i];
+    if (v.finger < 0) {
+      out[i] = Eigen::Vector3d(v.a, v.b, 0);
+      continue;
+    }
+    const FingerShape& F = G.fingers[v.finger];
+    const Link& L = links[first[v.finger] + v.link];
+    const double phi = F.direction_deg * kDeg;
+    const Eigen::Vector2d d(std::cos(phi), std::sin(phi)), l(-std::sin(phi), std::cos(phi));
+    const double r = L.hr + v.a * L.c, z = L.hz + v.a * L.s;
+    const Eigen::Vector2d p = F.base_mm + r * d + double(v.b) * l;
+    out[i] = Eigen::Vector3d(p.x(), p.y(), z);
+  }
+}
+
+void ArticulatedModel::pose(const Eigen::Ref<const Eigen::VectorXd>& h, std::vector<Eigen::Vector3d>& out) const {
+  pose_model(std::span<const double>(h.data() + kPoseDims, fingers()), out);
+  const Eigen::Matrix3d R = rotation_from_euler_deg(h[3], h[4], h[5]);
+  const Eigen::Vector3d t(h[0], h[1], h[2]);
+  for (auto& p : out) p = R * p + t;
+}
+
+std::vector<Eigen::Vector3d> ArticulatedModel::link_endpoints(const Eigen::Ref<const Eigen::VectorXd>& h) const {
+  const Eigen::Matrix3d R = rotation_from_euler_deg(h[3], h[4], h[5]);
+  const Eigen::Vector3d t(h[0], h[1], h[2]);
+  std::vector<Eigen::Vector3d> out;
+  for (int f = 0; f < fingers(); ++f) {
+    const FingerShape& F = geometry_.fingers[f];
+    const double q = h[kPoseDims + f] * kDeg, phi = F.direction_deg * kDeg;
+    const Eigen::Vector2d d(std::cos(phi), std::sin(phi));
+    double hr = 0, hz = 0;
+    for (size_t j = 0; j < F.links.size(); ++j) {
+      hr += F.links[j].length_mm * std::cos(double(j + 1) * q);
+      hz += F.links[j].length_mm * std::sin(double(j + 1) * q);
+      const Eigen::Vector2d p = F.base_mm + hr * d;
+      out.push_back(R * Eigen::Vector3d(p.x(), p.y(), hz) + t);
+    }
+  }
+  return out;
+}
+
+std::vector<Eigen::Vector3d> ArticulatedModel::fingertips(const Eigen::Ref<const Eigen::VectorXd>& h) const {
+  auto ends = link_endpoints(h);
+  std::vector<Eigen::Vector3d> tips;
+  size_t k = 0;
+  for (const auto& F : geometry_.fingers) {
+    k += F.links.size();
+    tips.push_back(ends[k - 1]);
+  }
+  return tips;
+}
+
+double ArticulatedModel::kinematic_penalty(std::span<const double> q) const {
+  const auto& G = geometry_;
+  const double span = std::max(1e-9, G.joint_max_deg - G.joint_min_deg);
+  double k = 0;
+  for (int f = 0; f < fingers(); ++f) {
+    k += std::max(0.0, G.joint_min_deg - q[f]) / span + std::max(0.0, q[f] - G.joint_max_deg) / span;
+  }
+  for (auto [a, b] : G.collision.adjacent) {
+    k += std::max(0.0, std::abs(q[a] - q[b]) - G.collision.max_difference_deg) / span;
+    k += std::max(0.0, q[a] + q[b] - G.collision.max_sum_deg) / span;
+  }
+  return k;
+}
+
+Eigen::VectorXd ArticulatedModel::symmetric_equivalent(const Eigen::Ref<const Eigen::VectorXd>& h, int k) const {
+  const int order = geometry_.symmetry_order;
+  k = ((k % order) + order) % order;
+  Eigen::VectorXd out = h;
+  if (k == 0) return out;
+  // Turning the model by alpha = k*360/order about its Z maps it onto itself
+  // with finger f moved to slot shift^k(f): R*M(q) = R*Rz(-alpha)*M(q') with
+  // q'[shift^k(f)] = q[f].
+  const double alpha = k * 360.0 / order;
+  const Eigen::Matrix3d R = rotation_from_euler_deg(h[3], h[4], h[5]) *
+                            rotation_from_euler_deg(0, 0, -alpha);
+  out.segment<3>(3) = euler_deg_from_rotation(R);
+  for (int f = 0; f < fingers(); ++f) {
+    int g = f;
+    for (int i = 0; i < k; ++i) g = finger_shift_[g];
+    out[kPoseDims + g] = h[kPoseDims + f];
+  }
+  return out;
+}
+
+double ArticulatedModel::radius_mm() const {
+  double r = 0;
+  for (const auto& p : geometry_.palm_mm) r = std::max(r, p.norm());
+  for (const auto& F : geometry_.fingers) {
+    double len = 0;
+    for (const auto& l : F.links) len += l.length_mm;
+    r = std::max(r, F.base_mm.norm() + len);
+  }
+  return r;
+}
+
+GripperGeometry make_radial_gripper(const RadialGripperSpec& s) {
+  if (s.palm_sides < 3 || s.fingers < 1 || s.palm_sides % s.fingers != 0) {
+    throw Error("gripper '" + s.name + "': palm_sides must be >= 3 and a multiple of the number of fingers");
+  }
+  GripperGeometry g;
+  g.name = s.name;
+  const double phase = s.finger_phase_deg * kDeg;
+  const double half = std::numbers::pi / s.palm_sides;  // edge k is centred at angle phase + 2k*half
+  for (int i = 0; i < s.palm_sides; ++i) {
+    const double a = phase + (2 * i - 1) * half;
+    g.palm_mm.emplace_back(s.palm_circumradius_mm * std::cos(a), s.palm_circumradius_mm * std::sin(a));
+  }
+  const double apothem = s.palm_circumradius_mm * std::cos(half);
+  const int every = s.palm_sides / s.fingers;
+  for (int f = 0; f < s.fingers; ++f) {
+    const double dir = phase + 2 * half * f * every;
+    FingerShape F;
+    F.direction_deg = dir / kDeg;
+    F.base_mm = apothem * Eigen::Vector2d(std::cos(dir), std::sin(dir));
+    F.links = s.links;
+    g.fingers.push_back(F);
+  }
+  for (int f = 0; f < s.fingers && s.fingers > 1; ++f) {
+    const int n = (f + 1) % s.fingers;
+    if (s.fingers == 2 && f == 1) break;
+    g.collision.adjacent.emplace_back(f, n);
+  }
+  g.symmetry_order = s.fingers;
+  return g;
+}
+
+}  // namespace gtrack

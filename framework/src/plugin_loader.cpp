@@ -1,0 +1,249 @@
+// PluginLoader: search, ABI check before any call, construction, lifetime.
+#include "gtrack/plugin_loader.hpp"
+
+#include <boost/dll/runtime_symbol_info.hpp>
+#include <boost/dll/shared_library.hpp>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+
+#include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
+
+namespace gtrack {
+
+namespace fs = std::filesystem;
+namespace dll = boost::dll;
+
+namespace {
+
+const std::string kPrefix = "libgtrack_";
+const std::string kSuffix = ".so";
+
+fs::path library_dir() {
+  // The folder of libgtrack.so itself: right for the gtrack executable, the
+  // tests and any program that links the framework, installed or not.
+  static const fs::path dir = [] {
+    std::error_code ec;
+    fs::path p = dll::this_line_location(ec);
+    if (ec) p = dll::program_location(ec);
+    return p.parent_path();
+  }();
+  return dir;
+}
+
+fs::path prefix_dir() {
+  fs::path p = library_dir();
+  for (const auto& part : fs::path(GTRACK_LIBDIR)) {
+    (void)part;
+    p = p.parent_path();
+  }
+  return p;
+}
+
+std::string library_file_name(const std::string& name) { return kPrefix + name + kSuffix; }
+
+std::shared_ptr<dll::shared_library> open_library(const fs::path& file) {
+  try {
+    return std::make_shared<dll::shared_library>(file, dll::load_mode::rtld_now | dll::load_mode::rtld_local);
+  } catch (const std::exception& e) {
+    std::string why = e.what();
+    // Boost wraps dlerror's text; keep only that part.
+    if (auto p = why.find("dlerror system message: "); p != std::string::npos) {
+      why = why.substr(p + 24);
+      if (auto q = why.rfind("): "); q != std::string::npos) why = why.substr(0, q);
+    }
+    throw PluginError(file.string() + ": cannot load library: " + why);
+  }
+}
+
+// Reads and checks PluginInfo. Only reads data: no function of the library
+// runs before this has passed.
+PluginRecord check_info(const dll::shared_library& lib, const fs::path& file) {
+  if (!lib.has("gtrack_plugin_info") || !lib.has("gtrack_plugin_create")) {
+    throw PluginError(file.string() +
+                      ": not a gtrack plugin (it exports no gtrack_plugin_info; was it built with GTRACK_PLUGIN?)");
+  }
+  const auto& head = lib.get_alias<const std::uint32_t>("gtrack_plugin_info");
+  const std::uint32_t* words = &head;
+  if (words[0] != GTRACK_PLUGIN_ABI_VERSION) {
+    throw PluginError(file.string() + ": plugin ABI version " + std::to_string(words[0]) +
+                      " does not match this gtrack's plugin ABI version " +
+                      std::to_string(GTRACK_PLUGIN_ABI_VERSION) + "; rebuild the plugin against this gtrack");
+  }
+  if (words[1] != sizeof(PluginInfo) || words[2] != alignof(PluginInfo)) {
+    throw PluginError(file.string() + ": plugin info record has size " + std::to_string(words[1]) + " and alignment " +
+                      std::to_string(words[2]) + ", expected " + std::to_string(sizeof(PluginInfo)) + " and " +
+                      std::to_string(alignof(PluginInfo)) + "; rebuild the plugin against this gtrack");
+  }
+  const auto& info = lib.get_alias<const PluginInfo>("gtrack_plugin_info");
+  if (info.kind != PluginKind::Sensor && info.kind != PluginKind::Gripper && info.kind != PluginKind::Stimulus) {
+    throw PluginError(file.string() + ": plugin declares an unknown kind (" +
+                      std::to_string(static_cast<std::uint32_t>(info.kind)) + ")");
+  }
+  if (!info.name || !*info.name) throw PluginError(file.string() + ": plugin has no name");
+  return PluginRecord{info.kind, info.name, info.version ? info.version : "", info.summary ? info.summary : "", file};
+}
+
+std::string join_paths(const std::vector<fs::path>& paths) {
+  std::string s;
+  for (const auto& p : paths) s += (s.empty() ? "" : ", ") + p.string();
+  return s.empty() ? "(none)" : s;
+}
+
+}  // namespace
+
+fs::path executable_dir() {
+  std::error_code ec;
+  return dll::program_location(ec).parent_path();
+}
+fs::path default_plugin_dir() { return library_dir() / "gtrack" / "plugins"; }
+fs::path data_dir() {
+  if (const char* env = std::getenv("GTRACK_DATA_DIR"); env && *env) return env;
+  return prefix_dir() / "share" / "gtrack";
+}
+
+PluginLoader::PluginLoader(std::vector<fs::path> user_paths) : initial_user_(std::move(user_paths)) {
+  if (const char* env = std::getenv("GTRACK_PLUGIN_PATH"); env && *env) {
+    std::string s = env;
+    size_t start = 0;
+    while (start <= s.size()) {
+      size_t colon = s.find(':', start);
+      if (colon == std::string::npos) colon = s.size();
+      if (colon > start) env_paths_.emplace_back(s.substr(start, colon - start));
+      start = colon + 1;
+    }
+  }
+  rebuild();
+}
+
+void PluginLoader::add_path(const fs::path& dir) {
+  user_.push_back(dir);
+  rebuild();
+}
+
+void PluginLoader::rebuild() {
+  // user paths given at construction keep their place before later additions
+  std::vector<fs::path> all;
+  for (const auto& p : initial_user_) all.push_back(p);
+  for (const auto& p : user_) all.push_back(p);
+  for (const auto& p : env_paths_) all.push_back(p);
+  all.push_back(default_plugin_dir());
+  paths_ = std::move(all);
+}
+
+PluginRecord PluginLoader::inspect(const fs::path& file) {
+  auto lib = open_library(file);
+  return check_info(*lib, file);
+}
+
+std::vector<PluginRecord> PluginLoader::discover() const {
+  std::vector<PluginRecord> out;
+  std::map<std::string, bool> seen;
+  for (const auto& dir : paths_) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) continue;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      const std::string n = e.path().filename().string();
+      if (n.size() > kPrefix.size() + kSuffix.size() && n.rfind(kPrefix, 0) == 0 &&
+          n.compare(n.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0) {
+        files.push_back(e.path());
+      }
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+      try {
+        PluginRecord r = inspect(f);
+        std::string key = std::string(to_string(r.kind)) + "/" + r.name;
+        if (seen[key]) continue;
+        seen[key] = true;
+        out.push_back(std::move(r));
+      } catch (const PluginError& e) {
+        logger().warn("skipping {}", e.what());
+      }
+    }
+  }
+  return out;
+}
+
+fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
+  for (const auto& dir : paths_) {
+    fs::path f = dir / library_file_name(name);
+    std::error_code ec;
+    if (fs::exists(f, ec)) return f;
+  }
+  std::string known;
+  for (const auto& r : discover()) {
+    if (r.kind == kind) known += (known.empty() ? "" : ", ") + r.name;
+  }
+  std::string msg = std::string(to_string(kind)) + " plugin '" + name + "' not found (looked for " +
+                    library_file_name(name) + " in: " + join_paths(paths_) + ")";
+  msg += known.empty() ? std::string("; no ") + to_string(kind) + " plugins were found there"
+                       : std::string("; available ") + to_string(kind) + " plugins: " + known;
+  throw PluginError(msg);
+}
+
+template <class Interface>
+std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, const std::string& name,
+                                                        const ConfigTable& table) const {
+  constexpr PluginKind kind = PluginTraits<Interface>::kind;
+  auto lib = open_library(file);
+  PluginRecord rec = check_info(*lib, file);
+  if (rec.kind != kind) {
+    throw PluginError(file.string() + ": plugin '" + rec.name + "' is a " + to_string(rec.kind) + " plugin; [" +
+                      table.path() + "] needs a " + to_string(kind) + " plugin");
+  }
+  if (rec.name != name) {
+    throw PluginError(file.string() + ": the library declares the plugin name '" + rec.name + "', expected '" + name +
+                      "'");
+  }
+  auto& factory = lib->get_alias<PluginFactory<Interface>>("gtrack_plugin_create");
+  Interface* raw = nullptr;
+  // The plugin's exception must be caught while its library is loaded.
+  try {
+    raw = factory(table);
+  } catch (const ConfigError& e) {
+    throw ConfigError(e.what());
+  } catch (const std::exception& e) {
+    throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
+                      "): could not be created: " + e.what());
+  } catch (...) {
+    throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
+                      "): could not be created: unknown exception");
+  }
+  if (!raw) {
+    throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
+                      "): factory returned nothing");
+  }
+  // The deleter owns the library: the instance is destroyed while its code
+  // is still mapped, and the library goes only after its last instance.
+  std::shared_ptr<Interface> instance(raw, [lib](Interface* p) { delete p; });
+  table.check_all_used();
+  logger().debug("loaded {} plugin '{}' {} from {}", to_string(kind), rec.name, rec.version, file.string());
+  return instance;
+}
+
+template <class Interface>
+std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
+  constexpr PluginKind kind = PluginTraits<Interface>::kind;
+  if (!table.has("plugin")) {
+    table.fail("plugin", std::string("missing; [") + table.path() + "] must name a " + to_string(kind) + " plugin");
+  }
+  const std::string name = table.string("plugin");
+  return make_from_file<Interface>(find(kind, name), name, table);
+}
+
+std::shared_ptr<Sensor> PluginLoader::make_sensor(const ConfigTable& t) const { return make<Sensor>(t); }
+std::shared_ptr<Gripper> PluginLoader::make_gripper(const ConfigTable& t) const { return make<Gripper>(t); }
+std::shared_ptr<Stimulus> PluginLoader::make_stimulus(const ConfigTable& t) const { return make<Stimulus>(t); }
+
+template GTRACK_API std::shared_ptr<Sensor> PluginLoader::make_from_file<Sensor>(const fs::path&, const std::string&,
+                                                                                 const ConfigTable&) const;
+template GTRACK_API std::shared_ptr<Gripper> PluginLoader::make_from_file<Gripper>(const fs::path&, const std::string&,
+                                                                                   const ConfigTable&) const;
+template GTRACK_API std::shared_ptr<Stimulus> PluginLoader::make_from_file<Stimulus>(const fs::path&,
+                                                                                     const std::string&,
+                                                                                     const ConfigTable&) const;
+
+}  // namespace gtrack

@@ -1,0 +1,136 @@
+// The `cpu` backend: poses, clips and fills every hypothesis of a batch on a
+// small thread pool, into one bit-packed mask per worker, and counts against
+// the bit-packed observation with AND + popcount.
+//
+// The mesh is filled face by face (faces.hpp) rather than triangle by
+// triangle. Work per hypothesis is confined to the box its polygons touch: the mask is
+// cleared there while counting, so it never needs a full clear. Every buffer
+// is owned by a worker and keeps its capacity, so after the first batch
+// nothing is allocated.
+#include <memory>
+#include <string>
+
+#include "gtrack/error.hpp"
+#include "gtrack/renderer.hpp"
+#include "render/bit_mask.hpp"
+#include "render/faces.hpp"
+#include "render/model_poser.hpp"
+#include "render/span_raster.hpp"
+#include "render/worker_pool.hpp"
+
+namespace gtrack {
+
+namespace {
+
+using render::BitMask;
+using render::Box;
+
+// Per worker; aligned so that two workers never share a cache line.
+struct alignas(64) Scratch {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<ScreenPolygon> polygons;
+  Projection model_projection;
+  BitMask mask;
+};
+
+class CpuRenderer final : public Renderer {
+ public:
+  explicit CpuRenderer(const RenderOptions& options) : pool_(options.threads) {
+    scratch_ = std::make_unique<Scratch[]>(pool_.size());
+  }
+
+  std::string name() const override { return "cpu"; }
+
+  void set_model(const ArticulatedModel& model) override {
+    poser_ = render::ModelPoser(model);
+    faces_ = render::Faces(model);
+  }
+
+  void set_projection(const Projection& projection, double scale) override {
+    projection_ = scaled_projection(projection, scale);
+    const ImageSize s = projection_.size;
+    observation_.resize(s.width, s.height);
+    observation_count_ = 0;
+    for (int w = 0; w < pool_.size(); ++w) scratch_[w].mask.resize(s.width, s.height);
+    has_projection_ = true;
+  }
+
+  ImageSize render_size() const override { return projection_.size; }
+
+  void set_observation(const cv::Mat& mask) override {
+    require_projection();
+    const ImageSize s = projection_.size;
+    if (mask.type() != CV_8UC1 || mask.cols != s.width || mask.rows != s.height) {
+      throw Error("cpu renderer: the observation must be CV_8U " + std::to_string(s.width) + "x" +
+                  std::to_string(s.height) + " (the render size), got " + std::to_string(mask.cols) + "x" +
+                  std::to_string(mask.rows) + " of type " + std::to_string(mask.type()));
+    }
+    observation_.pack(mask);
+    observation_count_ = observation_.count();
+  }
+
+  std::uint64_t observation_count() const override { return observation_count_; }
+
+  void submit(const Eigen::MatrixXd& hypotheses) override {
+    require_ready(hypotheses.rows());
+    const int n = static_cast<int>(hypotheses.cols());
+    results_.resize(n);
+    auto job = [&](int worker, int i) {
+      Scratch& s = scratch_[worker];
+      Box box;
+      fill(hypotheses.col(i).data(), s, box);
+      results_[i] = render::count_and_clear(s.mask, observation_, box);
+    };
+    pool_.run(n, job);
+  }
+
+  void finish(std::vector<PairCounts>& out) override { out.assign(results_.begin(), results_.end()); }
+
+  cv::Mat render_mask(const Eigen::VectorXd& hypothesis) override {
+    require_ready(hypothesis.size());
+    Scratch& s = scratch_[0];
+    Box box;
+    fill(hypothesis.data(), s, box);
+    cv::Mat out = s.mask.unpack();
+    s.mask.clear();
+    return out;
+  }
+
+ private:
+  void fill(const double* h, Scratch& s, Box& box) const {
+    poser_.pose_model(h, s.vertices);
+    render::ModelPoser::to_model_frame(h, projection_, s.model_projection);
+    faces_.project(s.vertices, s.model_projection, s.polygons);
+    render::fill_polygons(s.polygons, s.mask, box);
+  }
+
+  void require_projection() const {
+    if (!has_projection_) throw Error("cpu renderer: set_projection() must come before rendering");
+  }
+  void require_ready(Eigen::Index dims) const {
+    require_projection();
+    if (poser_.empty()) throw Error("cpu renderer: set_model() must come before rendering");
+    if (dims != poser_.dims()) {
+      throw Error("cpu renderer: a hypothesis has " + std::to_string(dims) + " values, the model needs " +
+                  std::to_string(poser_.dims()));
+    }
+  }
+
+  render::WorkerPool pool_;
+  std::unique_ptr<Scratch[]> scratch_;
+  render::ModelPoser poser_;
+  render::Faces faces_;
+  Projection projection_;
+  bool has_projection_ = false;
+  BitMask observation_;
+  std::uint64_t observation_count_ = 0;
+  std::vector<PairCounts> results_;
+};
+
+}  // namespace
+
+std::unique_ptr<Renderer> make_cpu_renderer(const RenderOptions& options) {
+  return std::make_unique<CpuRenderer>(options);
+}
+
+}  // namespace gtrack

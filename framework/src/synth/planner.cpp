@@ -1,0 +1,190 @@
+// Planning a synthetic sequence: the truth of every frame, before any image.
+//
+// Motion is built from smooth random paths (smooth_path.hpp) so that speeds
+// stay within what a gripper steered by magnets does; excursions out of the
+// field of view are blended in with smoothsteps; the joints come from the
+// Stimulus plugin's own hysteresis (target_joint_deg) through a first-order
+// lag per finger, so they fold late when heating and unfold late when
+// cooling, as the material does. Occlusion episodes cover the configured
+// share of frames; how much of the shape an occluder hides is a target that
+// the renderer meets by sizing the blob (render_frame).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "gtrack/error.hpp"
+#include "gtrack/synth.hpp"
+#include "synth/smooth_path.hpp"
+
+namespace gtrack {
+
+namespace {
+
+using synth::SmoothPath;
+using synth::smoothstep;
+
+struct Exit {
+  double t_mid, half_s;    // centre time and half duration (out and back)
+  Eigen::Vector2d target;  // palm centre (mm) when furthest out
+};
+
+std::vector<Exit> plan_exits(const SynthPreset& p, double duration, const Eigen::Vector2d& half_view, double radius,
+                             const Eigen::Vector2d& centre, std::mt19937_64& rng) {
+  std::vector<Exit> exits;
+  int n = static_cast<int>(std::lround(p.exits_per_minute * duration / 60.0));
+  if (duration >= 4.0) n = std::max(n, 1);
+  if (duration < 4.0) n = 0;  // too short to leave and come back
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < n; ++k) {
+    Exit e;
+    e.half_s = 0.9;
+    // Evenly spread after the first 1.5 s (the tracker's start).
+    const double lo = 1.5 + e.half_s, hi = duration - e.half_s - 0.5;
+    e.t_mid = lo + (hi - lo) * (k + 0.5) / n;
+    const int side = static_cast<int>(u(rng) * 4) % 4;
+    const double along = (u(rng) - 0.5) * 0.6;
+    const double ox = half_view.x() + p.exit_depth * radius, oy = half_view.y() + p.exit_depth * radius;
+    switch (side) {
+      case 0: e.target = {ox, along * half_view.y()}; break;
+      case 1: e.target = {-ox, along * half_view.y()}; break;
+      case 2: e.target = {along * half_view.x(), oy}; break;
+      default: e.target = {along * half_view.x(), -oy}; break;
+    }
+    e.target += centre;
+    exits.push_back(e);
+  }
+  return exits;
+}
+
+// Temperature: low, heat to high, hold, cool back, with soft corners.
+std::vector<double> stimulus_profile(const SynthPreset& p, const std::vector<double>& times, double duration,
+                                     std::mt19937_64& rng) {
+  const double period = std::clamp(duration, 2.5, p.stimulus_period_s);
+  std::normal_distribution<double> noise(0, p.stimulus_noise);
+  std::vector<double> out;
+  const double mid = 0.5 * (p.stimulus_low + p.stimulus_high), half = 0.5 * (p.stimulus_high - p.stimulus_low);
+  for (double t : times) {
+    const double s = std::clamp(1.4 * -std::cos(2 * std::numbers::pi * t / period), -1.0, 1.0);
+    out.push_back(mid + half * s + noise(rng));
+  }
+  return out;
+}
+
+std::vector<OccluderPlan> plan_occlusions(const SynthPreset& p, int frames, double fps, std::mt19937_64& rng) {
+  std::vector<OccluderPlan> plan(frames);
+  if (p.occluded_frames <= 0) return plan;
+  std::uniform_real_distribution<double> u(0, 1);
+  const double mean_len = 1.2 * fps;
+  const double mean_gap = mean_len * (1 - p.occluded_frames) / std::max(1e-3, p.occluded_frames);
+  int f = static_cast<int>(u(rng) * mean_gap);
+  while (f < frames) {
+    const int len = std::max(3, static_cast<int>(mean_len * (0.4 + 1.2 * u(rng))));
+    const double peak = p.max_occlusion * (0.45 + 0.55 * u(rng));
+    const double angle0 = 2 * std::numbers::pi * u(rng), drift = (u(rng) - 0.5) * 0.08;
+    const double dist = 0.15 + 0.5 * u(rng);
+    const double phase = 1000 * u(rng);
+    const bool tissue = u(rng) < 0.6;
+    for (int k = 0; k < len && f + k < frames; ++k) {
+      OccluderPlan& o = plan[f + k];
+      o.active = true;
+      // Fast rise, long plateau, fast fall.
+      o.target = std::min(p.max_occlusion, peak * std::sqrt(std::sin(std::numbers::pi * (k + 0.5) / len)));
+      const double a = angle0 + drift * k;
+      o.offset_px = dist * Eigen::Vector2d(std::cos(a), std::sin(a));  // in gripper radii; scaled when drawn
+      o.shape_phase = phase + 0.02 * k;
+      o.tissue_coloured = tissue;
+    }
+    f += len + std::max(1, static_cast<int>(mean_gap * (0.5 + u(rng))));
+  }
+  return plan;
+}
+
+}  // namespace
+
+SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
+  if (options.frames < 1) throw Error("a synthetic sequence needs at least one frame");
+  SynthPlan plan;
+  plan.preset = synth_preset(options.preset);
+  plan.options = options;
+  const SynthPreset& p = plan.preset;
+  const ArticulatedModel& model = setup.model();
+  const Sensor& sensor = *setup.sensor;
+  std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + 17);
+  std::uniform_real_distribution<double> u(0, 1);
+
+  const int n = options.frames;
+  const double fps = p.frame_rate_hz, duration = n / fps;
+  std::vector<double> times(n);
+  for (int i = 0; i < n; ++i) times[i] = i / fps;
+
+  const Eigen::Vector3d nominal = sensor.nominal_position_mm();
+  const double mmpp = sensor.mm_per_pixel(), radius = model.radius_mm();
+  const ImageSize size = sensor.image_size();
+  const Eigen::Vector2d half_view(0.5 * size.width * mmpp, 0.5 * size.height * mmpp);
+  const Eigen::Vector2d room = (half_view.array() - radius).max(0.25 * radius).matrix();
+
+  const double base_hz = 1.0 / p.motion_period_s;
+  const auto px = SmoothPath(rng, base_hz).sample(times), py = SmoothPath(rng, base_hz).sample(times);
+  const auto pz = SmoothPath(rng, base_hz).sample(times);
+  const auto prx = SmoothPath(rng, base_hz).sample(times), pry = SmoothPath(rng, base_hz).sample(times);
+  const auto prz = SmoothPath(rng, base_hz).sample(times);
+  const auto exits = plan_exits(p, duration, half_view, radius, nominal.head<2>(), rng);
+  const auto temperature = stimulus_profile(p, times, duration, rng);
+  auto occluders = plan_occlusions(p, n, fps, rng);
+
+  const double rz0 = 360 * u(rng) - 180, spin_sign = u(rng) < 0.5 ? -1 : 1;
+
+  // The material's response, from a stimulus instance of our own so that
+  // the setup's (the tracker's) stays untouched.
+  auto stimulus = setup.loader->make_stimulus(setup.root.table("stimulus"));
+  const int F = model.fingers(), L = model.max_links();
+  std::vector<double> lag(F), q(F, model.geometry().unfolded_deg);
+  for (int f = 0; f < F; ++f) lag[f] = p.joint_lag_s * (1 + p.joint_lag_spread * (2 * u(rng) - 1));
+  std::normal_distribution<double> hinge_noise(0, std::max(0.0, options.joint_noise_deg));
+  const auto& G = model.geometry();
+
+  for (int i = 0; i < n; ++i) {
+    const double t = times[i];
+    SynthFrame fr;
+    fr.frame = i;
+    fr.time_s = t;
+    fr.stimulus = temperature[i];
+    Eigen::VectorXd h(model.dims());
+    Eigen::Vector2d xy = nominal.head<2>() + p.inplane_amplitude * Eigen::Vector2d(room.x() * px[i], room.y() * py[i]);
+    for (const Exit& e : exits) {
+      const double w = smoothstep(e.t_mid - e.half_s, e.t_mid - 0.2 * e.half_s, t) *
+                       (1 - smoothstep(e.t_mid + 0.2 * e.half_s, e.t_mid + e.half_s, t));
+      xy = (1 - w) * xy + w * e.target;
+    }
+    // Tilts grow in over the first seconds, so the first frame is a fair start.
+    const double ramp = 0.3 + 0.7 * smoothstep(0, 1.5, t);
+    h[0] = xy.x();
+    h[1] = xy.y();
+    h[2] = nominal.z() + p.depth_amplitude_mm * pz[i];
+    h[3] = ramp * p.tilt_amplitude_deg * prx[i];
+    h[4] = ramp * p.tilt_amplitude_deg * pry[i];
+    double rz = rz0 + spin_sign * p.spin_deg_per_s * t + 0.25 * p.spin_deg_per_s * p.motion_period_s * prz[i];
+    h[5] = std::remainder(rz, 360.0);
+
+    stimulus->update(temperature[i], t);
+    if (i > 0) {
+      for (int f = 0; f < F; ++f) {
+        const double target = stimulus->target_joint_deg(q[f]);
+        q[f] += (target - q[f]) * (1 - std::exp(-(1.0 / fps) / lag[f]));
+        q[f] = std::clamp(q[f], G.joint_min_deg, G.joint_max_deg);
+      }
+    }
+    fr.hinge_deg.assign(F * L, 0.0);
+    for (int f = 0; f < F; ++f) {
+      h[kPoseDims + f] = q[f];
+      for (int j = 0; j < L; ++j) fr.hinge_deg[f * L + j] = q[f] + (options.joint_noise_deg > 0 ? hinge_noise(rng) : 0);
+    }
+    fr.truth = h;
+    fr.occluder = occluders[i];
+    plan.frames.push_back(std::move(fr));
+  }
+  return plan;
+}
+
+}  // namespace gtrack

@@ -1,0 +1,88 @@
+// gtrack synth as a library call: plan, draw in parallel, write the folder.
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <mutex>
+#include <thread>
+
+#include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
+#include "gtrack/sequence_io.hpp"
+#include "gtrack/synth.hpp"
+
+namespace gtrack {
+
+namespace fs = std::filesystem;
+
+SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& options, const fs::path& out) {
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  fs::create_directories(out / "frames", ec);
+  if (ec) throw InputError(out.string() + ": cannot create the folder (" + ec.message() + ")");
+
+  const SynthPlan plan = plan_sequence(setup, options);
+  const int n = static_cast<int>(plan.frames.size());
+  std::vector<SynthVisibility> vis(n);
+  std::atomic<int> next{0};
+  std::atomic<bool> failed{false};
+  std::string failure;
+  std::mutex failure_mutex;
+  // Frames are independent given the plan: draw them on every core.
+  auto worker = [&] {
+    for (int i = next++; i < n && !failed; i = next++) {
+      try {
+        const cv::Mat img = render_frame(setup, plan, i, &vis[i]);
+        char name[32];
+        std::snprintf(name, sizeof name, "%06d.png", i);
+        const fs::path file = out / "frames" / name;
+        // Fast PNG compression: the sequence is written once and read often.
+        if (!cv::imwrite(file.string(), img, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+          throw InputError(file.string() + ": cannot write");
+        }
+      } catch (const std::exception& e) {
+        std::lock_guard lock(failure_mutex);
+        failure = e.what();
+        failed = true;
+      }
+    }
+  };
+  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::clamp(threads, 1, std::max(1, n));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  if (failed) throw Error("synthetic sequence: " + failure);
+
+  {
+    std::ofstream csv(out / "stimulus.csv");
+    csv << "frame,value\n";
+    for (const auto& f : plan.frames) csv << f.frame << "," << f.stimulus << "\n";
+    if (!csv) throw InputError((out / "stimulus.csv").string() + ": write failed");
+  }
+  SynthSummary s;
+  s.frames = n;
+  {
+    std::ofstream csv(out / "ground_truth.csv");
+    csv << pose_table_header(setup.model().fingers(), {"visible", "in_view", "occluded"}) << "\n";
+    for (int i = 0; i < n; ++i) {
+      csv << pose_table_row(i, plan.frames[i].truth, {vis[i].visible, vis[i].in_view, vis[i].occluded}) << "\n";
+      if (vis[i].occluded > 0.01) {
+        ++s.occluded_frames;
+        s.mean_occlusion += vis[i].occluded;
+      }
+      s.max_occlusion = std::max(s.max_occlusion, vis[i].occluded);
+      if (vis[i].in_view < 0.99) ++s.partly_out_frames;
+      if (vis[i].in_view < 0.10) ++s.out_of_view_frames;
+    }
+    if (!csv) throw InputError((out / "ground_truth.csv").string() + ": write failed");
+  }
+  if (s.occluded_frames) s.mean_occlusion /= s.occluded_frames;
+  s.sequence_config = out / "sequence.toml";
+  write_sequence_config(setup.config_file, plan, s.sequence_config);
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return s;
+}
+
+}  // namespace gtrack

@@ -1,0 +1,179 @@
+// Reading the engine's tables: [observation] [pso] [cost] [render] [search] [tracker].
+#include "gtrack/engine_config.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gtrack/error.hpp"
+#include "gtrack/setup.hpp"
+
+namespace gtrack {
+
+namespace {
+
+const std::vector<std::string> kEngineTables = {"observation", "pso", "cost", "render", "search", "tracker"};
+// Tables other subcommands read from the same file; `track` ignores them.
+const std::vector<std::string> kOtherTables = {"synth", "sweep", "bench", "demo", "eval"};
+
+ObservationConfig read_observation(const ConfigTable& t, const Sensor& sensor) {
+  ObservationConfig o;
+  std::string dflt = sensor.segmentation_defaults().color_space;
+  if (dflt != "hsv" && dflt != "luminance") dflt = "hsv";
+  o.color_space = t.choice_or("color_space", dflt, {"hsv", "luminance"});
+  const Range hue = Range::closed(0, 180), byte = Range::closed(0, 255);
+  o.hue_min = t.number_or("hue_min", o.hue_min, hue);
+  o.hue_max = t.number_or("hue_max", o.hue_max, hue);
+  o.saturation_min = t.number_or("saturation_min", o.saturation_min, byte);
+  o.saturation_max = t.number_or("saturation_max", o.saturation_max, byte);
+  o.value_min = t.number_or("value_min", o.value_min, byte);
+  o.value_max = t.number_or("value_max", o.value_max, byte);
+  o.luminance_min = t.number_or("luminance_min", o.luminance_min, byte);
+  o.luminance_max = t.number_or("luminance_max", o.luminance_max, byte);
+  o.open_kernel_px = static_cast<int>(t.integer_or("open_kernel_px", o.open_kernel_px, Range::closed(0, 101)));
+  o.downscale_threshold =
+      t.number_or("downscale_threshold", o.downscale_threshold, {0.0, 1.0, true, false});
+  o.roi = t.boolean_or("roi", o.roi);
+  o.roi_margin_px = t.number_or("roi_margin_px", o.roi_margin_px, Range::non_negative());
+  o.prior = t.boolean_or("prior", o.prior);
+  o.prior_sigma_px = t.number_or("prior_sigma_px", o.prior_sigma_px, Range::positive());
+  o.prior_threshold = t.number_or("prior_threshold", o.prior_threshold, {0.0, 1.0, true, true});
+  if (o.saturation_min > o.saturation_max) t.fail("saturation_min", "must not exceed saturation_max");
+  if (o.value_min > o.value_max) t.fail("value_min", "must not exceed value_max");
+  if (o.luminance_min > o.luminance_max) t.fail("luminance_min", "must not exceed luminance_max");
+  return o;
+}
+
+PsoConfig read_pso(const ConfigTable& t) {
+  PsoConfig p;
+  p.particles = static_cast<int>(t.integer_or("particles", p.particles, Range::closed(2, 1 << 16)));
+  p.generations = static_cast<int>(t.integer_or("generations", p.generations, Range::closed(1, 1 << 16)));
+  p.inertia = t.number_or("inertia", p.inertia, Range::closed(0, 1.5));
+  p.c = t.number_or("c", p.c, Range::non_negative());
+  p.randomize_every = static_cast<int>(t.integer_or("randomize_every", p.randomize_every, Range::non_negative()));
+  p.randomize_fraction = t.number_or("randomize_fraction", p.randomize_fraction, {0.0, 1.0, true, false});
+  p.max_velocity_fraction = t.number_or("max_velocity_fraction", p.max_velocity_fraction, Range::non_negative());
+  p.seed = static_cast<std::uint64_t>(t.integer_or("seed", static_cast<long long>(p.seed), Range::non_negative()));
+  return p;
+}
+
+CostWeights read_cost(const ConfigTable& t) {
+  CostWeights c;
+  c.dice = t.number_or("lambda_dice", c.dice, Range::non_negative());
+  c.kinematic = t.number_or("lambda_kinematic", c.kinematic, Range::non_negative());
+  c.stimulus = t.number_or("lambda_stimulus", c.stimulus, Range::non_negative());
+  return c;
+}
+
+RenderOptions read_render(const ConfigTable& t) {
+  RenderOptions r;
+  r.backend = t.choice_or("backend", r.backend, {"auto", "gl", "cpu"});
+  r.scale = t.number_or("scale", r.scale, {0.0, 1.0, true, false});
+  r.threads = static_cast<int>(t.integer_or("threads", r.threads, Range::closed(0, 1024)));
+  r.egl_device = t.string_or("egl_device", r.egl_device);
+  return r;
+}
+
+Eigen::Vector3d vec3(const ConfigTable& t, const char* key, const Eigen::Vector3d& fallback) {
+  const auto v = t.numbers_or(key, {fallback.x(), fallback.y(), fallback.z()}, 3);
+  return {v[0], v[1], v[2]};
+}
+
+SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radius) {
+  // Default box: the field of view around the nominal position, grown by the
+  // model's radius so that a gripper half out of view is still reachable.
+  const ImageSize size = sensor.image_size();
+  const double half = 0.5 * std::max(size.width, size.height) * sensor.mm_per_pixel() + radius;
+  const Eigen::Vector3d nominal = sensor.nominal_position_mm();
+  SearchConfig s;
+  s.position_min_mm = vec3(t, "position_min_mm", nominal.array() - half);
+  s.position_max_mm = vec3(t, "position_max_mm", nominal.array() + half);
+  s.rotation_min_deg = vec3(t, "rotation_min_deg", s.rotation_min_deg);
+  s.rotation_max_deg = vec3(t, "rotation_max_deg", s.rotation_max_deg);
+  for (int i = 0; i < 3; ++i) {
+    if (!(s.position_min_mm[i] < s.position_max_mm[i])) t.fail("position_min_mm", "must be below position_max_mm");
+    if (!(s.rotation_min_deg[i] < s.rotation_max_deg[i])) t.fail("rotation_min_deg", "must be below rotation_max_deg");
+  }
+  return s;
+}
+
+TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, const ParameterSpace& space) {
+  TrackerConfig c;
+  const double r = model.radius_mm();
+  const std::vector<double> spread_default = {0.1 * r, 0.1 * r, 0.1 * r, 10, 10, 10, 10};
+  const auto spread = t.numbers_or("init_spread", spread_default, 7, Range::non_negative());
+  for (int i = 0; i < 7; ++i) c.init_spread[i] = spread[i];
+  const auto pose = t.numbers_or("initial_pose", {});
+  if (!pose.empty()) {
+    if (static_cast<int>(pose.size()) != model.dims()) {
+      t.fail("initial_pose", "expected " + std::to_string(model.dims()) +
+                                 " values x,y,z (mm), rx,ry,rz (deg), q1..qF (deg), got " +
+                                 std::to_string(pose.size()));
+    }
+    Eigen::VectorXd h = Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims());
+    if (!space.contains(h)) t.fail("initial_pose", "lies outside the [search] bounds or the joint limits");
+    c.initial_pose = h;
+  }
+  c.fps = t.number_or("fps", c.fps, Range::non_negative());
+  if (t.has("default_stimulus")) c.default_stimulus = t.number("default_stimulus");
+  c.lost_dice = t.number_or("lost_dice", c.lost_dice, {0.0, 1.0, true, false});
+  c.reinit_after_lost = static_cast<int>(t.integer_or("reinit_after_lost", c.reinit_after_lost, Range::closed(1, 1e6)));
+  c.coarse_rz_steps = static_cast<int>(t.integer_or("coarse_rz_steps", c.coarse_rz_steps, Range::closed(1, 360)));
+  c.coarse_candidates = static_cast<int>(t.integer_or("coarse_candidates", c.coarse_candidates, Range::closed(1, 64)));
+  c.progress_every = static_cast<int>(t.integer_or("progress_every", c.progress_every, Range::closed(1, 1e9)));
+  c.overlay = t.boolean_or("overlay", c.overlay);
+  return c;
+}
+
+}  // namespace
+
+EngineConfig engine_config(const Setup& setup) {
+  const ConfigTable& root = setup.root;
+  const ArticulatedModel& model = setup.model();
+  EngineConfig e;
+  {
+    const ConfigTable t = root.table("observation");
+    e.observation = read_observation(t, *setup.sensor);
+    t.check_all_used();
+  }
+  {
+    const ConfigTable t = root.table("pso");
+    e.pso = read_pso(t);
+    t.check_all_used();
+  }
+  {
+    const ConfigTable t = root.table("cost");
+    e.cost = read_cost(t);
+    t.check_all_used();
+  }
+  {
+    const ConfigTable t = root.table("render");
+    e.render = read_render(t);
+    t.check_all_used();
+  }
+  {
+    const ConfigTable t = root.table("search");
+    e.search = read_search(t, *setup.sensor, model.radius_mm());
+    t.check_all_used();
+  }
+  const auto& g = model.geometry();
+  const bool full_turn = std::abs(e.search.rotation_max_deg.z() - e.search.rotation_min_deg.z() - 360.0) < 1e-9;
+  e.space = ParameterSpace::make(model.fingers(), e.search.position_min_mm, e.search.position_max_mm,
+                                 e.search.rotation_min_deg, e.search.rotation_max_deg, g.joint_min_deg,
+                                 g.joint_max_deg, full_turn);
+  {
+    const ConfigTable t = root.table("tracker");
+    e.tracker = read_tracker(t, model, e.space);
+    t.check_all_used();
+  }
+  return e;
+}
+
+void check_root_keys(const Setup& setup) {
+  const ConfigTable& root = setup.root;
+  for (const auto& k : kEngineTables) root.mark_used(k);
+  for (const auto& k : kOtherTables) root.mark_used(k);
+  for (const char* k : {"plugin_path", "sensor", "gripper", "stimulus"}) root.mark_used(k);
+  root.check_all_used();
+}
+
+}  // namespace gtrack

@@ -1,0 +1,207 @@
+// Video files, image folders and live cameras behind one interface.
+#include "gtrack/frame_source.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+namespace fs = std::filesystem;
+
+FrameSource::~FrameSource() = default;
+
+namespace {
+
+std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+void check_size(const cv::Mat& img, ImageSize expected, const std::string& what) {
+  if (img.cols != expected.width || img.rows != expected.height) {
+    throw InputError(what + ": image is " + size_text(img.cols, img.rows) + " but the sensor expects " +
+                     size_text(expected.width, expected.height) + " (see [sensor] width/height)");
+  }
+}
+
+cv::Mat to_bgr(const cv::Mat& img) {
+  if (img.type() == CV_8UC3) return img;
+  cv::Mat out;
+  if (img.channels() == 1) cv::cvtColor(img, out, cv::COLOR_GRAY2BGR);
+  else if (img.channels() == 4) cv::cvtColor(img, out, cv::COLOR_BGRA2BGR);
+  else out = img;
+  if (out.depth() != CV_8U) out.convertTo(out, CV_8U, out.depth() == CV_16U ? 1.0 / 257.0 : 1.0);
+  return out;
+}
+
+// Decides which source indices are delivered, for every kind of source.
+class RangeFilter {
+ public:
+  explicit RangeFilter(FrameRange r) : r_(r) {}
+  bool done(int index) const { return r_.last >= 0 && index >= r_.last; }
+  bool wanted(int index) const {
+    return index >= r_.first && !done(index) && (index - r_.first) % std::max(1, r_.every) == 0;
+  }
+
+ private:
+  FrameRange r_;
+};
+
+class VideoSource final : public FrameSource {
+ public:
+  VideoSource(cv::VideoCapture cap, std::string name, ImageSize expected, FrameRange range, double fallback_fps,
+              bool live)
+      : cap_(std::move(cap)), name_(std::move(name)), expected_(expected), filter_(range), live_(live) {
+    fps_ = cap_.get(cv::CAP_PROP_FPS);
+    if (!(fps_ > 0 && fps_ < 1e4)) fps_ = fallback_fps;
+    count_ = live ? -1 : static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_COUNT));
+    if (count_ <= 0 && !live) count_ = -1;
+  }
+
+  std::optional<Frame> next() override {
+    for (;;) {
+      if (filter_.done(index_)) return std::nullopt;
+      if (!filter_.wanted(index_)) {
+        if (!cap_.grab()) return end_of_stream();
+        ++index_;
+        continue;
+      }
+      cv::Mat img;
+      if (!cap_.read(img) || img.empty()) return end_of_stream();
+      Frame f;
+      f.index = index_++;
+      f.time_s = fps_ > 0 ? f.index / fps_ : 0.0;
+      f.name = name_ + " frame " + std::to_string(f.index);
+      f.image = to_bgr(img);
+      check_size(f.image, expected_, f.name);
+      ++delivered_;
+      return f;
+    }
+  }
+  double fps() const override { return fps_; }
+  int frame_count() const override { return count_; }
+  std::string description() const override { return name_; }
+
+ private:
+  std::optional<Frame> end_of_stream() {
+    // A video that opens but yields nothing is as unusable as one that does not open.
+    if (index_ == 0 && delivered_ == 0 && !live_) {
+      throw InputError(name_ + ": no frame could be decoded (corrupt or unsupported video)");
+    }
+    return std::nullopt;
+  }
+  cv::VideoCapture cap_;
+  std::string name_;
+  ImageSize expected_;
+  RangeFilter filter_;
+  bool live_;
+  double fps_ = 0;
+  int count_ = -1;
+  int index_ = 0;
+  int delivered_ = 0;
+};
+
+class FolderSource final : public FrameSource {
+ public:
+  FolderSource(const fs::path& dir, ImageSize expected, FrameRange range, double fps)
+      : dir_(dir), expected_(expected), filter_(range), fps_(fps) {
+    static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (!e.is_regular_file()) continue;
+      std::string ext = e.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) files_.push_back(e.path());
+    }
+    std::sort(files_.begin(), files_.end());
+    if (files_.empty()) {
+      throw InputError(dir.string() + ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm)");
+    }
+  }
+
+  std::optional<Frame> next() override {
+    while (index_ < static_cast<int>(files_.size())) {
+      if (filter_.done(index_)) return std::nullopt;
+      const int i = index_++;
+      if (!filter_.wanted(i)) continue;
+      const fs::path& p = files_[static_cast<size_t>(i)];
+      cv::Mat img = cv::imread(p.string(), cv::IMREAD_COLOR);
+      if (img.empty()) throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format)");
+      Frame f;
+      f.index = i;
+      f.time_s = fps_ > 0 ? i / fps_ : 0.0;
+      f.name = p.string();
+      f.image = to_bgr(img);
+      check_size(f.image, expected_, p.string());
+      return f;
+    }
+    return std::nullopt;
+  }
+  double fps() const override { return fps_; }
+  int frame_count() const override { return static_cast<int>(files_.size()); }
+  std::string description() const override { return dir_.string() + " (" + std::to_string(files_.size()) + " images)"; }
+
+ private:
+  fs::path dir_;
+  std::vector<fs::path> files_;
+  ImageSize expected_;
+  RangeFilter filter_;
+  double fps_;
+  int index_ = 0;
+};
+
+}  // namespace
+
+FrameRange parse_frame_range(const std::string& text) {
+  FrameRange r;
+  const auto parse_int = [&](const std::string& s, int& out) {
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    if (s.empty() || ec != std::errc() || end != s.data() + s.size() || out < 0) {
+      throw InputError("--frames '" + text + "': expected A:B with non-negative frame indices (A inclusive, B exclusive)");
+    }
+  };
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) {
+    parse_int(text, r.first);
+    r.last = r.first + 1;
+    return r;
+  }
+  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+  if (!a.empty()) parse_int(a, r.first);
+  if (!b.empty()) parse_int(b, r.last);
+  if (r.last >= 0 && r.last <= r.first) {
+    throw InputError("--frames '" + text + "': the end (exclusive) must be after the start");
+  }
+  return r;
+}
+
+std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSize expected, FrameRange range,
+                                               double fallback_fps) {
+  if (range.every < 1) throw InputError("--every must be at least 1");
+  if (spec.rfind("camera:", 0) == 0) {
+    int dev = -1;
+    const std::string n = spec.substr(7);
+    auto [end, ec] = std::from_chars(n.data(), n.data() + n.size(), dev);
+    if (n.empty() || ec != std::errc() || end != n.data() + n.size() || dev < 0) {
+      throw InputError("'" + spec + "': expected camera:N with N a device number");
+    }
+    cv::VideoCapture cap(dev);
+    if (!cap.isOpened()) throw InputError("'" + spec + "': cannot open camera device " + n);
+    cap.set(cv::CAP_PROP_FRAME_WIDTH, expected.width);
+    cap.set(cv::CAP_PROP_FRAME_HEIGHT, expected.height);
+    return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, true);
+  }
+  const fs::path p(spec);
+  std::error_code ec;
+  if (!fs::exists(p, ec)) throw InputError(spec + ": no such file or folder");
+  if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps);
+  cv::VideoCapture cap;
+  // OpenCV prints its own warnings for undecodable files; the error below says it once.
+  if (!cap.open(spec, cv::CAP_ANY) || !cap.isOpened()) {
+    throw InputError(spec + ": cannot open as a video (corrupt or unsupported format)");
+  }
+  return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, false);
+}
+
+}  // namespace gtrack

@@ -1,0 +1,57 @@
+// The posed triangles, projected with the full sensor model, filled with
+// alpha and outlined, plus the reading and the frame's status as text.
+#include "overlay.hpp"
+
+#include <cstdio>
+#include <opencv2/imgproc.hpp>
+
+namespace gtrack::detail {
+
+cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const ArticulatedModel& model,
+                      const Stimulus* stimulus, const Estimate& estimate) {
+  cv::Mat out = frame.clone();
+  const cv::Scalar green(0, 220, 0);
+  const bool lost = estimate.status == TrackStatus::Lost;
+  if (estimate.hypothesis.size() == model.dims()) {
+    std::vector<Eigen::Vector3d> tris;
+    model.pose(estimate.hypothesis, tris);
+    cv::Mat fill = cv::Mat::zeros(frame.size(), CV_8U);
+    std::vector<std::vector<cv::Point>> outlines;
+    // Sub-pixel precision keeps thin links of a small gripper visible.
+    constexpr int shift = 4;
+    for (size_t i = 0; i + 2 < tris.size(); i += 3) {
+      std::vector<cv::Point> poly;
+      for (size_t k = 0; k < 3; ++k) {
+        const auto p = sensor.project(tris[i + k]);
+        if (!p) break;
+        poly.emplace_back(cvRound(p->x() * (1 << shift)), cvRound(p->y() * (1 << shift)));
+      }
+      if (poly.size() != 3) continue;
+      cv::fillConvexPoly(fill, poly, 255, cv::LINE_AA, shift);
+      outlines.push_back(std::move(poly));
+    }
+    cv::Mat tinted = out.clone();
+    tinted.setTo(green, fill);
+    cv::addWeighted(out, 0.55, tinted, 0.45, 0, out);
+    cv::polylines(out, outlines, true, lost ? cv::Scalar(0, 160, 255) : green, 1, cv::LINE_AA, shift);
+  }
+  const double font = std::max(0.5, frame.rows / 900.0);
+  const int thick = std::max(1, static_cast<int>(font * 1.5));
+  if (stimulus && estimate.stimulus) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%s = %.1f %s", stimulus->reading_label().c_str(), *estimate.stimulus,
+                  stimulus->reading_unit().c_str());
+    int base = 0;
+    const cv::Size ts = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, font, thick, &base);
+    const cv::Point at(frame.cols - ts.width - 12, frame.rows - 12);
+    cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(0, 0, 0), thick + 2, cv::LINE_AA);
+    cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(255, 255, 255), thick, cv::LINE_AA);
+  }
+  if (lost) {
+    cv::putText(out, "lost", cv::Point(12, static_cast<int>(30 * font)), cv::FONT_HERSHEY_SIMPLEX, font,
+                cv::Scalar(0, 160, 255), thick, cv::LINE_AA);
+  }
+  return out;
+}
+
+}  // namespace gtrack::detail

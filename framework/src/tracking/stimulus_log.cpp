@@ -1,0 +1,106 @@
+// Parsing and interpolating the stimulus CSV (frame,value or time_s,value).
+#include "gtrack/stimulus_log.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+namespace {
+
+std::string trim(std::string s) {
+  const auto not_space = [](unsigned char c) { return !std::isspace(c); };
+  s.erase(s.begin(), std::find_if(s.begin(), s.end(), not_space));
+  s.erase(std::find_if(s.rbegin(), s.rend(), not_space).base(), s.end());
+  return s;
+}
+
+bool parse_number(const std::string& text, double& out) {
+  const std::string t = trim(text);
+  if (t.empty()) return false;
+  auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), out);
+  return ec == std::errc() && end == t.data() + t.size() && std::isfinite(out);
+}
+
+}  // namespace
+
+StimulusLog StimulusLog::load(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open the stimulus log");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse(ss.str(), file.string());
+}
+
+StimulusLog StimulusLog::parse(const std::string& text, const std::string& source) {
+  StimulusLog log;
+  log.source_ = source;
+  std::istringstream in(text);
+  std::string line;
+  int lineno = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (lineno == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+    const std::string t = trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    const auto comma = t.find(',');
+    const std::string a = comma == std::string::npos ? t : trim(t.substr(0, comma));
+    const std::string b = comma == std::string::npos ? "" : trim(t.substr(comma + 1));
+    const std::string where = source + ":" + std::to_string(lineno) + ": ";
+    if (!header) {
+      if (comma == std::string::npos || b != "value" || (a != "frame" && a != "time_s")) {
+        throw InputError(where + "expected the header 'frame,value' or 'time_s,value', got '" + t + "'");
+      }
+      log.key_ = a == "frame" ? Key::Frame : Key::Time;
+      header = true;
+      continue;
+    }
+    const char* key_name = log.key_ == Key::Frame ? "a frame index" : "a time in seconds";
+    double k = 0, v = 0;
+    if (comma == std::string::npos || b.find(',') != std::string::npos) {
+      throw InputError(where + "expected two fields '<" + std::string(log.key_ == Key::Frame ? "frame" : "time_s") +
+                       ">,<value>', got '" + t + "'");
+    }
+    if (!parse_number(a, k) || (log.key_ == Key::Frame && (k < 0 || k != std::floor(k)))) {
+      throw InputError(where + "expected " + key_name + " in the first field, got '" + a + "'");
+    }
+    if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got '" + b + "'");
+    if (!log.keys_.empty() && !(k > log.keys_.back())) {
+      throw InputError(where + "expected " + key_name + " greater than the previous row's, got '" + a + "'");
+    }
+    log.keys_.push_back(k);
+    log.values_.push_back(v);
+  }
+  if (!header) throw InputError(source + ": empty stimulus log; expected the header 'frame,value' or 'time_s,value'");
+  if (log.keys_.empty()) throw InputError(source + ": the stimulus log has a header but no rows");
+  return log;
+}
+
+std::optional<double> StimulusLog::value_at(int frame, double time_s) const {
+  const double k = key_ == Key::Frame ? static_cast<double>(frame) : time_s;
+  // A small tolerance keeps time keys written with rounding inside the log.
+  const double eps = key_ == Key::Frame ? 0.0 : 1e-9;
+  if (k < keys_.front() - eps || k > keys_.back() + eps) return std::nullopt;
+  const auto it = std::lower_bound(keys_.begin(), keys_.end(), k);
+  if (it == keys_.end()) return values_.back();
+  const size_t i = static_cast<size_t>(it - keys_.begin());
+  if (*it == k || i == 0) return values_[i];
+  const double a = (k - keys_[i - 1]) / (keys_[i] - keys_[i - 1]);
+  return values_[i - 1] + a * (values_[i] - values_[i - 1]);
+}
+
+double StimulusLog::nearest(int frame, double time_s) const {
+  const double k = key_ == Key::Frame ? static_cast<double>(frame) : time_s;
+  if (k <= keys_.front()) return values_.front();
+  if (k >= keys_.back()) return values_.back();
+  return *value_at(frame, time_s);
+}
+
+}  // namespace gtrack

@@ -1,0 +1,211 @@
+// `gtrack track` as a library call: source -> Tracker -> files.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "gtrack/error.hpp"
+#include "gtrack/frame_source.hpp"
+#include "gtrack/log.hpp"
+#include "gtrack/results.hpp"
+#include "gtrack/stimulus_log.hpp"
+#include "gtrack/tracker.hpp"
+
+namespace gtrack {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// mp4 where the OpenCV build can write it, MJPG in AVI everywhere else.
+class OverlayWriter {
+ public:
+  OverlayWriter(fs::path dir, double fps) : dir_(std::move(dir)), fps_(fps > 0 ? fps : 30) {}
+  void write(const cv::Mat& img) {
+    if (!writer_.isOpened() && !failed_) open(img.size());
+    if (writer_.isOpened()) writer_.write(img);
+  }
+  void close() { writer_.release(); }
+  const fs::path& file() const { return file_; }
+
+ private:
+  void open(cv::Size size) {
+    const fs::path mp4 = dir_ / "overlay.mp4";
+    for (const char* cc : {"avc1", "mp4v"}) {
+      if (writer_.open(mp4.string(), cv::VideoWriter::fourcc(cc[0], cc[1], cc[2], cc[3]), fps_, size)) {
+        file_ = mp4;
+        return;
+      }
+    }
+    std::error_code ec;
+    fs::remove(mp4, ec);
+    const fs::path avi = dir_ / "overlay.avi";
+    if (writer_.open(avi.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_, size)) {
+      file_ = avi;
+      return;
+    }
+    failed_ = true;
+    logger().warn("cannot open a video writer for the overlay (neither mp4 nor MJPG/AVI); no overlay is written");
+  }
+  fs::path dir_;
+  double fps_;
+  cv::VideoWriter writer_;
+  fs::path file_;
+  bool failed_ = false;
+};
+
+class Progress {
+ public:
+  Progress(bool enabled, int total, int every) : enabled_(enabled), total_(total), every_(every) {
+    tty_ = ::isatty(STDERR_FILENO) != 0;
+  }
+  void update(int done, int frame, double elapsed_s) {
+    if (!enabled_) return;
+    const double fps = elapsed_s > 0 ? done / elapsed_s : 0;
+    if (tty_) {
+      if (done > 1 && seconds_since(last_) < 0.2) return;
+      last_ = Clock::now();
+    } else if (done % every_ != 0) {
+      return;
+    }
+    char eta[32] = "?";
+    if (total_ > 0 && fps > 0) {
+      const int s = static_cast<int>((total_ - done) / fps);
+      std::snprintf(eta, sizeof eta, "%d:%02d", s / 60, s % 60);
+    }
+    char line[160];
+    if (total_ > 0) {
+      std::snprintf(line, sizeof line, "frame %d (%d/%d)  %.1f fps  ETA %s", frame, done, total_, fps, eta);
+    } else {
+      std::snprintf(line, sizeof line, "frame %d (%d)  %.1f fps", frame, done, fps);
+    }
+    std::fprintf(stderr, tty_ ? "\r%-70s" : "%s\n", line);
+    std::fflush(stderr);
+    printed_ = true;
+  }
+  void finish() {
+    if (enabled_ && tty_ && printed_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_, tty_ = false, printed_ = false;
+  int total_, every_;
+  Clock::time_point last_ = Clock::now();
+};
+
+// How many frames the range will deliver, when the source knows its length.
+int expected_frames(const FrameSource& src, const FrameRange& r) {
+  int n = src.frame_count();
+  if (n < 0) return -1;
+  if (r.last >= 0) n = std::min(n, r.last);
+  if (n <= r.first) return 0;
+  return (n - r.first + r.every - 1) / r.every;
+}
+
+}  // namespace
+
+TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
+  const auto start = Clock::now();
+  // Inputs are checked before anything is written.
+  std::optional<StimulusLog> log;
+  if (options.stimulus_csv) log = StimulusLog::load(*options.stimulus_csv);
+  auto source = open_frame_source(options.input, setup.sensor->image_size(), options.range,
+                                  config.tracker.fps > 0 ? config.tracker.fps : 30.0);
+  const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
+
+  ResultWriter results(options.out_dir, setup.model().fingers());
+  if (options.save_masks) {
+    std::error_code ec;
+    fs::create_directories(options.out_dir / "masks", ec);
+    if (ec) throw InputError((options.out_dir / "masks").string() + ": cannot create (" + ec.message() + ")");
+  }
+  Tracker tracker(setup, config);
+  const bool want_overlay = options.overlay.value_or(config.tracker.overlay);
+  OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every));
+  Progress progress(options.progress, expected_frames(*source, options.range), config.tracker.progress_every);
+
+  if (!log && !config.tracker.default_stimulus) {
+    logger().info("no stimulus log and no [tracker] default_stimulus: S(H) and the biased initialisation are off");
+  } else if (!log) {
+    logger().info("no stimulus log: the stimulus is held at [tracker] default_stimulus = {}",
+                  *config.tracker.default_stimulus);
+  }
+  logger().info("tracking {} with the {} renderer ({}x{} render size), N={} G={}", source->description(),
+                tracker.renderer().name(), tracker.renderer().render_size().width,
+                tracker.renderer().render_size().height, config.pso.particles, config.pso.generations);
+
+  TrackSummary summary;
+  summary.renderer = tracker.renderer().name();
+  double cost_sum = 0, ms_sum = 0;
+  StageTimes sums;
+  bool warned_range = false;
+  for (;;) {
+    if (options.cancel && options.cancel->load()) {
+      summary.cancelled = true;
+      break;
+    }
+    const auto t_read = Clock::now();
+    std::optional<Frame> frame = source->next();
+    if (!frame) break;
+    double io_ms = seconds_since(t_read) * 1e3;
+    const double time_s = frame->index / fps;
+
+    std::optional<double> reading;
+    if (log) {
+      reading = log->value_at(frame->index, time_s);
+      if (!reading) {
+        if (!warned_range) {
+          logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log; holding its nearest reading",
+                        log->source(), frame->index, time_s);
+          warned_range = true;
+        }
+        reading = log->nearest(frame->index, time_s);
+      }
+    }
+
+    Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
+
+    const auto t_write = Clock::now();
+    if (options.save_masks) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%06d.png", frame->index);
+      const fs::path p = options.out_dir / "masks" / name;
+      if (!cv::imwrite(p.string(), tracker.last_observation().mask)) throw InputError(p.string() + ": cannot write");
+    }
+    if (want_overlay) overlay.write(tracker.draw_overlay(frame->image, e));
+    io_ms += seconds_since(t_write) * 1e3;
+    e.times.io_ms = io_ms;
+    results.write(e);
+    if (options.on_frame) options.on_frame(e);
+
+    ++summary.frames;
+    if (e.status == TrackStatus::Lost) ++summary.lost_frames;
+    else cost_sum += e.terms.total;
+    ms_sum += e.ms;
+    sums.segment_ms += e.times.segment_ms;
+    sums.pso_ms += e.times.pso_ms;
+    sums.io_ms += e.times.io_ms;
+    progress.update(summary.frames, frame->index, seconds_since(start));
+  }
+  progress.finish();
+  results.close();
+  overlay.close();
+
+  const int n = std::max(1, summary.frames);
+  const int found = summary.frames - summary.lost_frames;
+  summary.mean_cost = found > 0 ? cost_sum / found : 0.0;
+  summary.mean_ms = ms_sum / n;
+  summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
+  summary.wall_s = seconds_since(start);
+  summary.overlay_file = overlay.file();
+  write_summary(options.out_dir / "summary.json", summary);
+  return summary;
+}
+
+}  // namespace gtrack

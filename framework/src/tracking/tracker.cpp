@@ -1,0 +1,233 @@
+// One frame of tracking: observe, optimise, decide (see tracker.hpp).
+#include "gtrack/tracker.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "coarse_search.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
+
+namespace gtrack {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A frame's own random stream: the same frame gets the same draws whatever
+// range of the sequence is tracked.
+std::uint64_t frame_seed(std::uint64_t seed, int index) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (static_cast<std::uint64_t>(index) + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+const char* to_string(TrackStatus status) {
+  switch (status) {
+    case TrackStatus::Tracked: return "ok";
+    case TrackStatus::Search: return "search";
+    case TrackStatus::Lost: return "lost";
+  }
+  return "?";
+}
+
+struct Tracker::Impl {
+  Setup setup;
+  EngineConfig config;
+  std::unique_ptr<Renderer> renderer;
+  std::unique_ptr<Segmenter> segmenter;
+  std::unique_ptr<CostEvaluator> cost;
+  Projection render_projection;
+  std::optional<Eigen::VectorXd> last;
+  bool started = false;  // a frame has been processed since construction or reset
+  int lost = 0;          // consecutive lost frames
+  Observation observation;
+
+  Impl(const Setup& s, EngineConfig c, std::unique_ptr<Renderer> r)
+      : setup(s), config(std::move(c)), renderer(std::move(r)) {
+    if (!setup.sensor || !setup.gripper) throw Error("tracker: the setup has no sensor or gripper");
+    renderer->set_model(setup.model());
+    const Projection projection = setup.sensor->projection();
+    renderer->set_projection(projection, config.render.scale);
+    render_projection = scaled_projection(projection, config.render.scale);
+    segmenter = std::make_unique<Segmenter>(config.observation, setup.sensor->image_size(), renderer->render_size());
+    cost = std::make_unique<CostEvaluator>(std::vector<Renderer*>{renderer.get()}, *setup.gripper, nullptr,
+                                           config.cost);
+  }
+
+  Eigen::VectorXd spread() const {
+    const int dims = config.space.dims();
+    Eigen::VectorXd s(dims);
+    const auto& t = config.tracker.init_spread;
+    s.head<kPoseDims>() = t.head<kPoseDims>();
+    s.tail(dims - kPoseDims).setConstant(t[6]);
+    return s;
+  }
+
+  // Something to report before anything was ever found.
+  Eigen::VectorXd fallback_pose() const {
+    if (config.tracker.initial_pose) return *config.tracker.initial_pose;
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(config.space.dims());
+    h.head<3>() = setup.sensor->nominal_position_mm();
+    h.tail(config.space.fingers()).setConstant(setup.model().geometry().unfolded_deg);
+    config.space.clamp(h);
+    return h;
+  }
+
+  // The joint values the coarse search tries: between the reference shapes,
+  // narrowed to what the stimulus allows now.
+  std::pair<double, double> joint_range(bool stimulus_on) const {
+    const auto& g = setup.model().geometry();
+    double lo = std::max(g.joint_min_deg, std::min(g.unfolded_deg, g.folded_deg));
+    double hi = std::min(g.joint_max_deg, std::max(g.unfolded_deg, g.folded_deg));
+    if (stimulus_on) {
+      const StimulusState st = setup.stimulus->state();
+      const double flo = std::max(lo, st.feasible_min_deg), fhi = std::min(hi, st.feasible_max_deg);
+      if (flo <= fhi) {
+        lo = flo;
+        hi = fhi;
+      }
+    }
+    return {lo, hi};
+  }
+
+  Estimate process(const cv::Mat& input, int index, double time_s, std::optional<double> reading) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Estimate e;
+    e.frame = index;
+    e.time_s = time_s;
+    std::mt19937_64 rng(frame_seed(config.pso.seed, index));
+
+    if (!reading && config.tracker.default_stimulus) reading = config.tracker.default_stimulus;
+    const bool stimulus_on = reading.has_value() && setup.stimulus != nullptr;
+    if (stimulus_on) setup.stimulus->update(*reading, time_s);
+    e.stimulus = reading;
+    cost->set_stimulus(stimulus_on ? setup.stimulus.get() : nullptr);
+
+    // Observation: around the previous estimate while it is trusted, the
+    // whole image when there is none or it has been lost for too long.
+    const cv::Mat frame = setup.sensor->rectify(input);
+    const bool searching = !last || lost >= config.tracker.reinit_after_lost;
+    if (!searching) {
+      ObservationPrior prior;
+      prior.previous_mask = renderer->render_mask(*last);
+      prior.margin_scale = 1.0 + lost;
+      observation = segmenter->observe(frame, &prior);
+    } else {
+      observation = segmenter->observe(frame, nullptr);
+    }
+    e.observed_pixels = observation.count;
+    e.times.segment_ms = ms_since(t0);
+
+    const auto t1 = std::chrono::steady_clock::now();
+    if (observation.empty()) {
+      ++lost;
+      e.status = TrackStatus::Lost;
+      e.hypothesis = last ? *last : fallback_pose();
+      renderer->set_observation(observation.mask);
+      e.terms = cost->evaluate_one(e.hypothesis);
+    } else {
+      renderer->set_observation(observation.mask);
+      const std::uint64_t evals0 = cost->evaluations();
+      Eigen::VectorXd best;
+      if (searching && !started && config.tracker.initial_pose) {
+        best = optimise(*config.tracker.initial_pose, stimulus_on, rng);
+        e.status = TrackStatus::Tracked;
+      } else if (searching) {
+        const auto [jlo, jhi] = joint_range(stimulus_on);
+        detail::CoarseSearchInput in;
+        in.observation = &observation.mask;
+        in.render_projection = render_projection;
+        in.nominal_mm = setup.sensor->nominal_position_mm();
+        in.model = &setup.model();
+        in.joint_lo = jlo;
+        in.joint_hi = jhi;
+        best = detail::coarse_search(in, config, *cost, rng).best;
+        e.status = TrackStatus::Search;
+      } else {
+        best = optimise(*last, stimulus_on, rng);
+        e.status = TrackStatus::Tracked;
+      }
+      e.terms = cost->evaluate_one(best);
+      e.evaluations = cost->evaluations() - evals0;
+      if (e.terms.dice > config.tracker.lost_dice) {
+        ++lost;
+        e.status = TrackStatus::Lost;
+        if (!last) last = best;
+        e.hypothesis = best;
+      } else {
+        lost = 0;
+        last = best;
+        e.hypothesis = best;
+      }
+    }
+    started = true;
+    e.times.pso_ms = ms_since(t1);
+    e.ms = ms_since(t0);
+    return e;
+  }
+
+  Eigen::VectorXd optimise(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng) {
+    const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
+    const Eigen::VectorXd s = spread();
+    Eigen::VectorXd start = from;
+    config.space.clamp(start);
+    const Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, config.pso.particles, config.space, rng);
+    ParticleSwarm pso(config.pso, config.space);
+    pso.set_randomization_spread(s);
+    const PsoResult r = pso.run(
+        init, [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
+    return r.best;
+  }
+};
+
+Tracker::Tracker(const Setup& setup, EngineConfig config)
+    : Tracker(setup, config, make_renderer(config.render)) {}
+
+Tracker::Tracker(const Setup& setup, EngineConfig config, std::unique_ptr<Renderer> renderer)
+    : impl_(std::make_unique<Impl>(setup, std::move(config), std::move(renderer))) {}
+
+Tracker::~Tracker() = default;
+
+Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::optional<double> stimulus) {
+  return impl_->process(frame, index, time_s, stimulus);
+}
+
+void Tracker::reset() {
+  impl_->last.reset();
+  impl_->started = false;
+  impl_->lost = 0;
+}
+
+void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
+  if (hypothesis.size() != impl_->config.space.dims()) {
+    throw Error("set_estimate: expected " + std::to_string(impl_->config.space.dims()) + " parameters");
+  }
+  impl_->last = hypothesis;
+  impl_->started = true;
+  impl_->lost = 0;
+}
+
+const std::optional<Eigen::VectorXd>& Tracker::last_estimate() const { return impl_->last; }
+const Observation& Tracker::last_observation() const { return impl_->observation; }
+Renderer& Tracker::renderer() { return *impl_->renderer; }
+const EngineConfig& Tracker::config() const { return impl_->config; }
+const ParameterSpace& Tracker::space() const { return impl_->config.space; }
+
+}  // namespace gtrack
+
+#include "overlay.hpp"
+
+namespace gtrack {
+
+cv::Mat Tracker::draw_overlay(const cv::Mat& frame, const Estimate& estimate) const {
+  return detail::draw_estimate(frame, *impl_->setup.sensor, impl_->setup.model(), impl_->setup.stimulus.get(),
+                               estimate);
+}
+
+}  // namespace gtrack

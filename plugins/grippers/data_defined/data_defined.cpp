@@ -1,0 +1,125 @@
+// data_defined: a gripper described entirely in TOML, no compiler needed.
+//
+// The model is read from the [gripper] table itself or, with model_file, from
+// a separate TOML file (a relative path is taken from the config's folder).
+// The format is documented in docs/plugins.md ("A gripper in a file"):
+//   name; palm_mm = [[x, y], ...] (convex, counter-clockwise) with
+//   [[finger]] tables (base_mm = [x, y], direction_deg, link_lengths_mm,
+//   link_widths_mm: one more than links, the width at each hinge and at the
+//   tip), or a [radial] table that generates palm and identical fingers
+//   (fingers, palm_sides, palm_circumradius_mm, phase_deg, link_lengths_mm,
+//   link_widths_mm); joint_min_deg, joint_max_deg; adjacent = [[1, 2], ...]
+//   (1-based; default: each finger with the next, around);
+//   max_adjacent_difference_deg, max_adjacent_sum_deg; symmetry_order;
+//   unfolded_deg, folded_deg.
+#include <filesystem>
+#include <gtrack/error.hpp>
+#include <gtrack/plugin.hpp>
+
+namespace {
+
+using gtrack::ConfigTable;
+using gtrack::Range;
+
+std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
+  const auto lengths = t.numbers("link_lengths_mm", std::nullopt, Range::positive());
+  if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
+  const auto widths = t.numbers("link_widths_mm", lengths.size() + 1, Range::non_negative());
+  std::vector<gtrack::LinkShape> links;
+  for (size_t j = 0; j < lengths.size(); ++j) {
+    if (widths[j] <= 0 && widths[j + 1] <= 0) t.fail("link_widths_mm", "a link needs a width at one end at least");
+    links.push_back({lengths[j], widths[j], widths[j + 1]});
+  }
+  return links;
+}
+
+gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
+  gtrack::GripperGeometry g;
+  const std::string name = t.string_or("name", "data_defined");
+  if (t.has("radial")) {
+    if (t.has("finger") || t.has("palm_mm")) t.fail("radial", "give either [radial] or palm_mm with [[finger]]");
+    const ConfigTable r = t.table("radial");
+    gtrack::RadialGripperSpec spec;
+    spec.name = name;
+    spec.fingers = static_cast<int>(r.integer("fingers", Range{1, 64}));
+    spec.palm_sides = static_cast<int>(r.integer_or("palm_sides", std::max(3, spec.fingers), Range{3, 256}));
+    if (spec.palm_sides % spec.fingers != 0) r.fail("palm_sides", "must be a multiple of fingers");
+    spec.palm_circumradius_mm = r.number("palm_circumradius_mm", Range::positive());
+    spec.finger_phase_deg = r.number_or("phase_deg", 0.0);
+    spec.links = read_links(r);
+    r.check_all_used();
+    g = gtrack::make_radial_gripper(spec);
+  } else {
+    for (const auto& p : t.number_rows("palm_mm", 2)) g.palm_mm.emplace_back(p[0], p[1]);
+    if (g.palm_mm.size() < 3) t.fail("palm_mm", "the palm needs at least 3 points");
+    double area = 0;
+    for (size_t i = 0; i < g.palm_mm.size(); ++i) {
+      const auto& a = g.palm_mm[i];
+      const auto& b = g.palm_mm[(i + 1) % g.palm_mm.size()];
+      area += a.x() * b.y() - a.y() * b.x();
+    }
+    if (area <= 0) t.fail("palm_mm", "the palm polygon must be counter-clockwise with a positive area");
+    const auto fingers = t.tables("finger");
+    if (fingers.empty()) t.fail("finger", "missing; add one [[finger]] table per finger (or use [radial])");
+    for (const auto& f : fingers) {
+      gtrack::FingerShape F;
+      auto b = f.numbers("base_mm", 2);
+      F.base_mm = {b[0], b[1]};
+      F.direction_deg = f.number("direction_deg", Range::closed(-360, 360));
+      F.links = read_links(f);
+      f.check_all_used();
+      g.fingers.push_back(F);
+    }
+    const int n = static_cast<int>(g.fingers.size());
+    for (int i = 0; i < n && n > 1; ++i) {
+      if (n == 2 && i == 1) break;
+      g.collision.adjacent.emplace_back(i, (i + 1) % n);
+    }
+  }
+  g.name = name;
+  if (t.has("adjacent")) {
+    g.collision.adjacent.clear();
+    for (const auto& p : t.number_rows("adjacent", 2, Range::closed(1, static_cast<double>(g.fingers.size())))) {
+      g.collision.adjacent.emplace_back(static_cast<int>(p[0]) - 1, static_cast<int>(p[1]) - 1);
+    }
+  }
+  g.joint_min_deg = t.number_or("joint_min_deg", -10, Range::closed(-180, 180));
+  g.joint_max_deg = t.number_or("joint_max_deg", 90, Range::closed(-180, 180));
+  if (!(g.joint_min_deg < g.joint_max_deg)) t.fail("joint_max_deg", "must be greater than joint_min_deg");
+  g.collision.max_difference_deg = t.number_or("max_adjacent_difference_deg", 45, Range::positive());
+  g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", 1e9, Range::positive());
+  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", 1, Range{1, 64}));
+  g.unfolded_deg = t.number_or("unfolded_deg", 0);
+  g.folded_deg = t.number_or("folded_deg", 60);
+  return g;
+}
+
+gtrack::ArticulatedModel load_model(const ConfigTable& t) {
+  if (!t.has("model_file")) return gtrack::ArticulatedModel(read_geometry(t));
+  std::filesystem::path file = t.string("model_file");
+  if (file.is_relative() && !t.source().empty()) file = std::filesystem::path(t.source()).parent_path() / file;
+  const ConfigTable m = ConfigTable::load_file(file.string());
+  gtrack::GripperGeometry g = read_geometry(m);
+  m.check_all_used();
+  return gtrack::ArticulatedModel(std::move(g));
+}
+
+class DataDefinedGripper final : public gtrack::Gripper {
+ public:
+  explicit DataDefinedGripper(const ConfigTable& t) try : model_(load_model(t)) {
+  } catch (const gtrack::ConfigError&) {
+    throw;
+  } catch (const gtrack::Error& e) {
+    // Geometry checks of the framework: say which table they are about.
+    throw gtrack::ConfigError(t.where("plugin") + ": " + e.what());
+  }
+  const gtrack::ArticulatedModel& model() const override { return model_; }
+
+ private:
+  gtrack::ArticulatedModel model_;
+};
+
+}  // namespace
+
+GTRACK_PLUGIN(DataDefinedGripper, gtrack::Gripper, "data_defined", "1.0.0",
+              "any gripper described in TOML: palm polygon, fingers as planar link chains")

@@ -1,0 +1,152 @@
+// temperature_hysteresis: thermally responsive grippers (paper 2.2, 3, 5).
+//
+// Two behaviours, chosen by `mode`:
+//   reversible (hydrogel): unfolded at or below `unfold_below_C`, folded at or
+//     above `fold_above_C`, anywhere in between while the temperature crosses
+//     that range (the hysteresis band, 24-27 C for pNIPAM-AAc);
+//   latching (metallic): unfolded until the temperature first reaches
+//     `trigger_C` (37 C: the polymer trigger softens), then free to fold, and
+//     never unfolds again.
+// S(H) is the paper's rule: joints outside the band the state allows are
+// infeasible; S is the mean absolute error of those joints against the
+// reference value (unfolded_deg or folded_deg, with `tolerance_deg`),
+// divided by |folded - unfolded| so that it is comparable with D in [0, 1].
+// The swarm bias is the paper's: 75% of particles start with increased joints
+// when heating in the folding range, 25% when cooling in it, 50% otherwise.
+#include <algorithm>
+#include <cmath>
+#include <gtrack/plugin.hpp>
+
+namespace {
+
+class TemperatureHysteresis final : public gtrack::Stimulus {
+ public:
+  explicit TemperatureHysteresis(const gtrack::ConfigTable& t) {
+    using gtrack::Range;
+    mode_ = t.choice_or("mode", "reversible", {"reversible", "latching"});
+    unfold_below_ = t.number_or("unfold_below_C", 24.0, Range::closed(-50, 150));
+    fold_above_ = t.number_or("fold_above_C", 27.0, Range::closed(-50, 150));
+    trigger_ = t.number_or("trigger_C", 37.0, Range::closed(-50, 150));
+    unfolded_ = t.number_or("unfolded_deg", 0.0, Range::closed(-180, 180));
+    folded_ = t.number_or("folded_deg", 60.0, Range::closed(-180, 180));
+    tolerance_ = t.number_or("tolerance_deg", 10.0, Range::non_negative());
+    min_rate_ = t.number_or("trend_threshold_C_per_s", 0.005, Range::non_negative());
+    smoothing_s_ = t.number_or("trend_smoothing_s", 2.0, Range::positive());
+    fold_bias_ = t.number_or("fold_bias", 0.75, Range::closed(0.5, 1.0));
+    if (mode_ == "reversible" && !(unfold_below_ < fold_above_)) {
+      t.fail("fold_above_C", "must be greater than unfold_below_C");
+    }
+    if (folded_ == unfolded_) t.fail("folded_deg", "must differ from unfolded_deg");
+    state_.value = unfold_below_;
+    refresh();
+  }
+
+  void update(double value, double time_s) override {
+    if (std::isfinite(value)) {
+      if (has_prev_ && time_s > prev_time_) {
+        const double raw = (value - state_.value) / (time_s - prev_time_);
+        const double a = std::min(1.0, (time_s - prev_time_) / smoothing_s_);
+        state_.rate += a * (raw - state_.rate);
+      }
+      state_.value = value;
+      prev_time_ = time_s;
+      has_prev_ = true;
+      if (mode_ == "latching" && value >= trigger_) triggered_ = true;
+    }
+    refresh();
+  }
+
+  gtrack::StimulusState state() const override { return state_; }
+
+  double penalty(std::span<const double> q) const override {
+    double sum = 0;
+    int infeasible = 0;
+    for (double v : q) {
+      if (v >= state_.feasible_min_deg && v <= state_.feasible_max_deg) continue;
+      sum += std::abs(v - (v < state_.feasible_min_deg ? low_ref_ : high_ref_));
+      ++infeasible;
+    }
+    return infeasible ? sum / infeasible / std::abs(folded_ - unfolded_) : 0.0;
+  }
+
+  double fold_fraction() const override {
+    // Folding means moving from unfolded_deg towards folded_deg.
+    const double toward_fold = folded_ > unfolded_ ? fold_bias_ : 1.0 - fold_bias_;
+    switch (state_.trend) {
+      case gtrack::StimulusTrend::Folding: return state_.in_transition ? toward_fold : 0.5;
+      case gtrack::StimulusTrend::Unfolding: return state_.in_transition ? 1.0 - toward_fold : 0.5;
+      default: return 0.5;
+    }
+  }
+
+  double target_joint_deg(double current) const override {
+    const double T = state_.value;
+    if (mode_ == "latching") return triggered_ ? folded_ : current;
+    if (T >= fold_above_) return folded_;
+    if (T <= unfold_below_) return unfolded_;
+    const double s = (T - unfold_below_) / (fold_above_ - unfold_below_);
+    const double level = unfolded_ + s * (folded_ - unfolded_);
+    // Hysteresis: heating only folds further, cooling only unfolds.
+    const bool folded_more = (folded_ > unfolded_) ? level > current : level < current;
+    if (state_.rate > 0) return folded_more ? level : current;
+    if (state_.rate < 0) return folded_more ? current : level;
+    return current;
+  }
+
+  std::string reading_label() const override { return "T"; }
+  std::string reading_unit() const override { return "C"; }
+
+ private:
+  void refresh() {
+    const double T = state_.value;
+    const double lo = std::min(unfolded_, folded_) - tolerance_, hi = std::max(unfolded_, folded_) + tolerance_;
+    state_.trend = state_.rate > min_rate_    ? gtrack::StimulusTrend::Folding
+                   : state_.rate < -min_rate_ ? gtrack::StimulusTrend::Unfolding
+                                              : gtrack::StimulusTrend::Steady;
+    low_ref_ = std::min(unfolded_, folded_);
+    high_ref_ = std::max(unfolded_, folded_);
+    if (mode_ == "latching") {
+      state_.in_transition = triggered_;
+      if (triggered_) {
+        state_.feasible_min_deg = lo;
+        state_.feasible_max_deg = hi;
+        // Folding is still under way: the trend is folding while triggered.
+        state_.trend = gtrack::StimulusTrend::Folding;
+      } else {
+        set_band(unfolded_);
+      }
+      return;
+    }
+    state_.in_transition = T > unfold_below_ - tolerance_band_C() && T < fold_above_ + tolerance_band_C();
+    if (T >= fold_above_) {
+      set_band(folded_);
+    } else if (T <= unfold_below_) {
+      set_band(unfolded_);
+    } else {
+      state_.feasible_min_deg = lo;
+      state_.feasible_max_deg = hi;
+    }
+  }
+
+  // The folding range is entered slightly before its nominal edges.
+  double tolerance_band_C() const { return 0.5; }
+
+  void set_band(double ref) {
+    state_.feasible_min_deg = ref - tolerance_;
+    state_.feasible_max_deg = ref + tolerance_;
+    low_ref_ = high_ref_ = ref;
+  }
+
+  std::string mode_;
+  double unfold_below_, fold_above_, trigger_, unfolded_, folded_, tolerance_, min_rate_, smoothing_s_, fold_bias_;
+  gtrack::StimulusState state_;
+  double low_ref_ = 0, high_ref_ = 0;
+  double prev_time_ = 0;
+  bool has_prev_ = false;
+  bool triggered_ = false;
+};
+
+}  // namespace
+
+GTRACK_PLUGIN(TemperatureHysteresis, gtrack::Stimulus, "temperature_hysteresis", "1.0.0",
+              "thermally responsive folding: reversible hysteresis band (hydrogel) or latching trigger (metallic)")

@@ -1,0 +1,109 @@
+// The gtrack executable as a user runs it: exit codes and one-line errors.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int code;
+  std::string output;  // stdout and stderr
+};
+
+CliRun gtrack(const std::string& args) {
+  const std::string cmd = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (p && std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  int status = p ? ::pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path write(const std::string& name, const std::string& text) {
+  fs::path p = fs::temp_directory_path() / "gtrack_cli_test";
+  fs::create_directories(p);
+  p /= name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+const std::string kConfig =
+    "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\nfx = 3200\n"
+    "[gripper]\nplugin = \"hydrogel_six_finger\"\n";
+
+TEST(Cli, PluginsListsTheBuiltInsEachFromItsOwnLibrary) {
+  CliRun r = gtrack("plugins");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("sensor\tpinhole_microscope\t"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("gripper\thydrogel_six_finger\t"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("stimulus\ttemperature_hysteresis\t"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("libgtrack_pinhole_microscope.so"), std::string::npos);
+}
+
+TEST(Cli, MisspelledKeyIsOneLineWithFileLineKey) {
+  fs::path cfg = write("typo.toml", kConfig + "link_lenghts_mm = [0.3, 0.3]\n");
+  CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out /tmp/x.png");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(cfg.string() + ":8: key 'gripper.link_lenghts_mm'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("did you mean 'link_lengths_mm'"), std::string::npos) << r.output;
+}
+
+TEST(Cli, UnknownPluginListsThoseThatExist) {
+  fs::path cfg = write("unknown.toml", "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 64\nheight = 64\nfx = 100\n"
+                                       "[gripper]\nplugin = \"hydrogel_seven_finger\"\n");
+  CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out /tmp/x.png");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("gripper plugin 'hydrogel_seven_finger' not found"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("available gripper plugins: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("hydrogel_six_finger"), std::string::npos) << r.output;
+}
+
+TEST(Cli, RenderWritesMaskAndObj) {
+  fs::path cfg = write("ok.toml", kConfig);
+  fs::path png = fs::temp_directory_path() / "gtrack_cli_test" / "mask.png";
+  fs::path obj = fs::temp_directory_path() / "gtrack_cli_test" / "posed.obj";
+  CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,100,10,0,0,0,10,20,30,40,50 --out " +
+                 png.string() + " --obj " + obj.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(png));
+  std::ifstream in(obj);
+  std::string line;
+  int v = 0, f = 0;
+  while (std::getline(in, line)) {
+    v += line.rfind("v ", 0) == 0;
+    f += line.rfind("f ", 0) == 0;
+  }
+  EXPECT_EQ(f, 46);
+  EXPECT_EQ(v, 46 * 3);
+}
+
+TEST(Cli, BadParameterVectorIsOneLine) {
+  fs::path cfg = write("ok2.toml", kConfig);
+  CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,abc --out /tmp/x.png");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("field 3 ('abc')"), std::string::npos) << r.output;
+  r = gtrack("render --config " + cfg.string() + " --params 0,0,1 --out /tmp/x.png");
+  EXPECT_NE(r.output.find("got 3 values, expected 12"), std::string::npos) << r.output;
+}
+
+TEST(Cli, UsageErrors) {
+  EXPECT_EQ(gtrack("rendr").code, 2);
+  EXPECT_EQ(gtrack("render").code, 2);
+  CliRun v = gtrack("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_NE(v.output.find("gtrack "), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,476 @@
+// The gl backend against the cpu backend and the brute-force oracle
+// (tests/support/reference_raster): on a microscope camera, on an ultrasound
+// slab (orthographic, two clip planes), across layer boundaries of the
+// 32-hypotheses-per-layer packing, and its errors.
+//
+// The GPU computes vertices in float and snaps them to 1/256 pixel itself,
+// the oracle in double, so a pixel centre within float noise of an edge may
+// fall either way: masks are compared by IoU and counts with a tolerance.
+// Skipped only when no EGL context can be made at all.
+#include <gtest/gtest.h>
+#include <gtrack/error.hpp>
+#include <gtrack/renderer.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <random>
+#include <string>
+#include <unistd.h>
+
+#include "support/reference_raster.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using gtrack::ArticulatedModel;
+using gtrack::PairCounts;
+using gtrack::Projection;
+using gtrack::RenderOptions;
+using gtrack::Renderer;
+using gtrack::testing::hydrogel_geometry;
+using gtrack::testing::microscope_projection;
+using gtrack::testing::reference_mask;
+
+constexpr double kScale = 0.25;
+constexpr char kNoContext[] = "gl backend: no EGL context";
+
+// Sets an environment variable for the scope and restores it after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      setenv(name_, old_->c_str(), 1);
+    } else {
+      unsetenv(name_);
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+// The renderer, or the reason there is no EGL context on this machine.
+std::unique_ptr<Renderer> make_gl(std::string& skip, const RenderOptions& options = {}) {
+  try {
+    return gtrack::make_gl_renderer(options);
+  } catch (const gtrack::Error& e) {
+    if (std::string(e.what()).rfind(kNoContext, 0) != 0) throw;
+    skip = e.what();
+    return nullptr;
+  }
+}
+
+#define GL_OR_SKIP(var, ...)                                      \
+  std::string var##_skip;                                         \
+  auto var = make_gl(var##_skip __VA_OPT__(, ) __VA_ARGS__);      \
+  if (!var) GTEST_SKIP() << "no EGL context: " << var##_skip
+
+std::unique_ptr<Renderer> make_cpu() {
+  RenderOptions o;
+  o.backend = "cpu";
+  o.threads = 1;
+  return gtrack::make_cpu_renderer(o);
+}
+
+// 1024x1024 camera rendered at 256x256; at z = 45 mm the gripper is ~114 px across.
+Projection camera() { return microscope_projection(1024, 1024, 5120, 5120, 512, 512, 0.1); }
+
+// An ultrasound-like slice: an oblique imaging plane through (0, 0, 40) mm,
+// 0.02 mm per pixel at full resolution, orthographic along the plane normal,
+// and a slab of `thickness_mm` around the plane (two clip planes).
+Projection ultrasound_slab(double thickness_mm) {
+  const Eigen::Matrix3d axes = gtrack::rotation_from_euler_deg(25, -15, 10);
+  const Eigen::Vector3d e1 = axes.col(0), e2 = axes.col(1), n = axes.col(2);
+  const Eigen::Vector3d origin(0.3, -0.2, 40);
+  const double mm_per_px = 0.02;
+  Projection p;
+  p.size = {1024, 768};
+  p.world_to_image.row(0) << e1.transpose() / mm_per_px, -e1.dot(origin) / mm_per_px + 512;
+  p.world_to_image.row(1) << e2.transpose() / mm_per_px, -e2.dot(origin) / mm_per_px + 384;
+  p.world_to_image.row(2) << 0, 0, 0, 1;
+  p.clip_planes.emplace_back(n.x(), n.y(), n.z(), -n.dot(origin) + thickness_mm / 2);
+  p.clip_planes.emplace_back(-n.x(), -n.y(), -n.z(), n.dot(origin) + thickness_mm / 2);
+  return p;
+}
+
+// Any orientation, fingers from slightly open to folded back over the palm,
+// some partly out of the image and some cut by the near plane.
+Eigen::MatrixXd camera_hypotheses(int n, std::uint32_t seed, int fingers) {
+  std::mt19937 rng(seed);
+  auto U = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  Eigen::MatrixXd H(6 + fingers, n);
+  for (int i = 0; i < n; ++i) {
+    const bool close = i % 25 == 24;
+    H(0, i) = close ? U(-0.5, 0.5) : U(-4, 4);
+    H(1, i) = close ? U(-0.5, 0.5) : U(-4, 4);
+    H(2, i) = close ? U(0.5, 3.0) : U(35, 60);
+    H(3, i) = U(-80, 80);
+    H(4, i) = U(-80, 80);
+    H(5, i) = U(-180, 180);
+    for (int f = 0; f < fingers; ++f) H(6 + f, i) = U(-10, 150);
+  }
+  return H;
+}
+
+// Around the slab's plane, so that the slab cuts most of them.
+Eigen::MatrixXd slab_hypotheses(int n, std::uint32_t seed, int fingers) {
+  std::mt19937 rng(seed);
+  auto U = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  Eigen::MatrixXd H(6 + fingers, n);
+  for (int i = 0; i < n; ++i) {
+    H(0, i) = U(-2, 2);
+    H(1, i) = U(-2, 2);
+    H(2, i) = 40 + U(-1.5, 1.5);
+    H(3, i) = U(-90, 90);
+    H(4, i) = U(-90, 90);
+    H(5, i) = U(-180, 180);
+    for (int f = 0; f < fingers; ++f) H(6 + f, i) = U(-10, 120);
+  }
+  return H;
+}
+
+double iou(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat i, u;
+  cv::bitwise_and(a, b, i);
+  cv::bitwise_or(a, b, u);
+  const int nu = cv::countNonZero(u);
+  return nu == 0 ? 1.0 : double(cv::countNonZero(i)) / nu;
+}
+
+// Masks agree when their IoU is >= 0.995; a mask too small for that to mean
+// anything (a sliver at the image border) may differ by 2 pixels.
+::testing::AssertionResult masks_agree(const cv::Mat& got, const cv::Mat& want) {
+  cv::Mat diff;
+  cv::compare(got, want, diff, cv::CMP_NE);
+  const int differ = cv::countNonZero(diff);
+  const double v = iou(got, want);
+  if (v >= 0.995 || differ <= 2) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "IoU " << v << ", " << differ << " pixels differ of "
+                                       << cv::countNonZero(want);
+}
+
+// Within 0.5%, with 2 pixels of slack for small counts.
+::testing::AssertionResult counts_agree(std::uint32_t got, std::uint32_t want) {
+  const double slack = std::max(2.0, 0.005 * want);
+  if (std::abs(double(got) - double(want)) <= slack) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << got << " vs " << want;
+}
+
+PairCounts mask_counts(const cv::Mat& mask, const cv::Mat& observation) {
+  cv::Mat both;
+  cv::bitwise_and(mask, observation, both);
+  return {static_cast<std::uint32_t>(cv::countNonZero(both)), static_cast<std::uint32_t>(cv::countNonZero(mask))};
+}
+
+struct Scene {
+  ArticulatedModel model;
+  Projection projection;  // full resolution
+  cv::Mat observation;    // at render size
+};
+
+// An observation that overlaps many hypotheses: the union of a few posed
+// grippers, as the oracle renders them.
+cv::Mat observation_for(const Scene& s, const Eigen::MatrixXd& poses) {
+  const Projection p = gtrack::scaled_projection(s.projection, kScale);
+  cv::Mat obs = cv::Mat::zeros(p.size.height, p.size.width, CV_8UC1);
+  for (int i = 0; i < poses.cols(); ++i) cv::bitwise_or(obs, reference_mask(s.model, p, poses.col(i)), obs);
+  return obs;
+}
+
+// Renders every hypothesis with gl, cpu and the oracle; checks masks and the
+// batched counts of gl against the cpu's.
+void expect_agreement(Renderer& gl, const Scene& s, const Eigen::MatrixXd& H, int oracle_every) {
+  auto cpu = make_cpu();
+  for (Renderer* r : {&gl, cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+  }
+  ASSERT_EQ(gl.render_size().width, cpu->render_size().width);
+  ASSERT_EQ(gl.render_size().height, cpu->render_size().height);
+  EXPECT_EQ(gl.observation_count(), cpu->observation_count());
+  const Projection p = gtrack::scaled_projection(s.projection, kScale);
+
+  std::vector<PairCounts> from_gl, from_cpu;
+  gl.evaluate(H, from_gl);
+  cpu->evaluate(H, from_cpu);
+  ASSERT_EQ(from_gl.size(), static_cast<size_t>(H.cols()));
+  ASSERT_EQ(from_cpu.size(), static_cast<size_t>(H.cols()));
+
+  int nonempty = 0, overlapping = 0, failures = 0;
+  double total_gl = 0, total_cpu = 0;
+  for (int i = 0; i < H.cols() && failures < 10; ++i) {
+    const Eigen::VectorXd h = H.col(i);
+    const cv::Mat mg = gl.render_mask(h);
+    const cv::Mat mc = cpu->render_mask(h);
+    ASSERT_EQ(mg.type(), CV_8UC1);
+    ASSERT_EQ(mg.size(), mc.size());
+    nonempty += cv::countNonZero(mc) > 0;
+    overlapping += from_cpu[i].intersection > 0;
+    total_gl += from_gl[i].rendered;
+    total_cpu += from_cpu[i].rendered;
+
+    bool ok = true;
+    auto check = [&](::testing::AssertionResult r, const char* what) {
+      if (!r) {
+        ADD_FAILURE() << what << ", hypothesis " << i << " (" << h.transpose() << "): " << r.message();
+        ok = false;
+      }
+    };
+    check(masks_agree(mg, mc), "gl mask vs cpu mask");
+    if (i % oracle_every == 0) check(masks_agree(mg, reference_mask(s.model, p, h)), "gl mask vs oracle");
+    check(counts_agree(from_gl[i].rendered, from_cpu[i].rendered), "|P| gl vs cpu");
+    check(counts_agree(from_gl[i].intersection, from_cpu[i].intersection), "|O&P| gl vs cpu");
+    // The batch counts are those of the mask the same backend renders.
+    const PairCounts own = mask_counts(mg, s.observation);
+    check(counts_agree(from_gl[i].rendered, own.rendered), "|P| batch vs own mask");
+    check(counts_agree(from_gl[i].intersection, own.intersection), "|O&P| batch vs own mask");
+    failures += !ok;
+  }
+  EXPECT_GT(nonempty, H.cols() * 3 / 5);
+  EXPECT_GT(overlapping, H.cols() / 10);
+  EXPECT_NEAR(total_gl, total_cpu, 0.001 * total_cpu);
+}
+
+TEST(GlRenderer, OpensAHeadlessContext) {
+  GL_OR_SKIP(r);
+  EXPECT_EQ(r->name(), "gl");
+  EXPECT_EQ(r->render_size().width, 0);
+  r->set_projection(camera(), kScale);
+  EXPECT_EQ(r->render_size().width, 256);
+  EXPECT_EQ(r->render_size().height, 256);
+  // Cached and harmless without a GPU: just ask twice.
+  EXPECT_EQ(gtrack::hardware_gpu_available(), gtrack::hardware_gpu_available());
+}
+
+TEST(GlRenderer, AgreesWithCpuAndOracleOnAPerspectiveCamera) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(1000, 11, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(12));
+  expect_agreement(*gl, s, H, 1);
+}
+
+TEST(GlRenderer, AgreesWithCpuAndOracleOnAnUltrasoundSlab) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), ultrasound_slab(0.6), {}};
+  const Eigen::MatrixXd H = slab_hypotheses(400, 5, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(12));
+  expect_agreement(*gl, s, H, 1);
+}
+
+TEST(GlRenderer, TheSlabKeepsOnlyWhatIsInsideIt) {
+  GL_OR_SKIP(gl);
+  const ArticulatedModel model(hydrogel_geometry());
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(model.dims());
+  h.head<3>() << 0.3, -0.2, 40;  // on the plane, lying in it
+  const Eigen::Matrix3d axes = gtrack::rotation_from_euler_deg(25, -15, 10);
+  h.segment<3>(3) = gtrack::euler_deg_from_rotation(axes);
+  gl->set_model(model);
+  gl->set_projection(ultrasound_slab(0.6), kScale);
+  const int flat = cv::countNonZero(gl->render_mask(h));
+  EXPECT_GT(flat, 200);
+  // Folded fingers rise out of the slab: less is imaged.
+  for (int f = 0; f < model.fingers(); ++f) h[6 + f] = 80;
+  EXPECT_LT(cv::countNonZero(gl->render_mask(h)), flat);
+  // Moved off the plane by more than its own reach: nothing.
+  h.head<3>() += axes.col(2) * 3.0;
+  EXPECT_EQ(cv::countNonZero(gl->render_mask(h)), 0);
+}
+
+TEST(GlRenderer, BatchesOfAnySizeMatchOneAtATime) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(100, 3, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(8));
+  gl->set_model(s.model);
+  gl->set_projection(s.projection, kScale);
+  gl->set_observation(s.observation);
+
+  std::vector<PairCounts> single(static_cast<size_t>(H.cols())), out;
+  for (int i = 0; i < H.cols(); ++i) {
+    gl->evaluate(H.col(i), out);
+    ASSERT_EQ(out.size(), 1u);
+    single[static_cast<size_t>(i)] = out[0];
+  }
+  // Sizes around the 32-hypothesis layers, and empty.
+  for (int n : {0, 1, 31, 32, 33, 64, 65, 100}) {
+    gl->evaluate(H.leftCols(n), out);
+    ASSERT_EQ(out.size(), static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(out[i].rendered, single[i].rendered) << "batch " << n << ", hypothesis " << i;
+      EXPECT_EQ(out[i].intersection, single[i].intersection) << "batch " << n << ", hypothesis " << i;
+    }
+  }
+}
+
+TEST(GlRenderer, SubmitReturnsAndFinishCollects) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(64, 9, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(4));
+  gl->set_model(s.model);
+  gl->set_projection(s.projection, kScale);
+  gl->set_observation(s.observation);
+  std::vector<PairCounts> a, b;
+  gl->evaluate(H, a);
+
+  gl->submit(H);
+  EXPECT_THROW(gl->submit(H), gtrack::Error);
+  // A mask may be rendered while a batch is in flight; the batch keeps its counts.
+  const cv::Mat m = gl->render_mask(H.col(5));
+  gl->finish(b);
+  EXPECT_THROW(gl->finish(b), gtrack::Error);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].rendered, b[i].rendered);
+    EXPECT_EQ(a[i].intersection, b[i].intersection);
+  }
+  EXPECT_EQ(static_cast<std::uint32_t>(cv::countNonZero(m)), a[5].rendered);
+}
+
+TEST(GlRenderer, TwoRenderersInOneThreadKeepTheirOwnState) {
+  GL_OR_SKIP(first);
+  GL_OR_SKIP(second);
+  const ArticulatedModel model(hydrogel_geometry());
+  const Eigen::MatrixXd H = camera_hypotheses(40, 21, model.fingers());
+  first->set_model(model);
+  second->set_model(model);
+  first->set_projection(camera(), kScale);
+  second->set_projection(ultrasound_slab(0.6), kScale);
+  std::vector<PairCounts> a1, b1, a2;
+  first->evaluate(H, a1);
+  second->evaluate(H, b1);
+  first->evaluate(H, a2);
+  ASSERT_EQ(a1.size(), a2.size());
+  for (size_t i = 0; i < a1.size(); ++i) EXPECT_EQ(a1[i].rendered, a2[i].rendered);
+  second.reset();  // the display stays up for the first
+  first->evaluate(H, a2);
+  for (size_t i = 0; i < a1.size(); ++i) EXPECT_EQ(a1[i].rendered, a2[i].rendered);
+}
+
+TEST(GlRenderer, ReusesItsObjectsWhenSizesChange) {
+  GL_OR_SKIP(gl);
+  const ArticulatedModel model(hydrogel_geometry());
+  const Eigen::MatrixXd H = camera_hypotheses(70, 4, model.fingers());
+  auto cpu = make_cpu();
+  std::vector<PairCounts> g, c;
+  for (double scale : {0.25, 0.5, 0.125}) {
+    for (Renderer* r : {gl.get(), cpu.get()}) {
+      r->set_model(model);
+      r->set_projection(camera(), scale);
+    }
+    gl->evaluate(H, g);
+    cpu->evaluate(H, c);
+    for (size_t i = 0; i < g.size(); ++i) {
+      EXPECT_TRUE(counts_agree(g[i].rendered, c[i].rendered)) << "scale " << scale << ", hypothesis " << i;
+    }
+  }
+}
+
+TEST(GlRenderer, RejectsMisuseWithOneLine) {
+  GL_OR_SKIP(gl);
+  const ArticulatedModel model(hydrogel_geometry());
+  std::vector<PairCounts> out;
+  EXPECT_THROW(gl->submit(Eigen::MatrixXd::Zero(model.dims(), 1)), gtrack::Error);  // no model yet
+  gl->set_model(model);
+  EXPECT_THROW(gl->set_observation(cv::Mat::zeros(8, 8, CV_8UC1)), gtrack::Error);   // no projection yet
+  gl->set_projection(camera(), kScale);
+  EXPECT_THROW(gl->submit(Eigen::MatrixXd::Zero(model.dims() + 1, 2)), gtrack::Error);
+  EXPECT_THROW(gl->set_observation(cv::Mat::zeros(8, 8, CV_8UC1)), gtrack::Error);
+  EXPECT_THROW(gl->set_observation(cv::Mat::zeros(256, 256, CV_32FC1)), gtrack::Error);
+  try {
+    gl->finish(out);
+    ADD_FAILURE() << "finish() without submit() was accepted";
+  } catch (const gtrack::Error& e) {
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+}
+
+TEST(GlRenderer, NamesAnUnknownDevice) {
+  RenderOptions o;
+  o.egl_device = "97";
+  try {
+    gtrack::make_gl_renderer(o);
+    ADD_FAILURE() << "device 97 was accepted";
+  } catch (const gtrack::Error& e) {
+    const std::string m = e.what();
+    if (m.rfind(kNoContext, 0) == 0) GTEST_SKIP() << m;
+    EXPECT_NE(m.find("97"), std::string::npos) << m;
+    EXPECT_NE(m.find("does not exist"), std::string::npos) << m;
+  }
+  o.egl_device = "gpu-please";
+  EXPECT_THROW(gtrack::make_gl_renderer(o), gtrack::Error);
+}
+
+TEST(GlRenderer, SurfacelessCanBeChosen) {
+  RenderOptions o;
+  o.egl_device = "surfaceless";
+  GL_OR_SKIP(gl, o);
+  gl->set_model(ArticulatedModel(hydrogel_geometry()));
+  gl->set_projection(camera(), kScale);
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(12);
+  h[2] = 45;
+  EXPECT_GT(cv::countNonZero(gl->render_mask(h)), 1000);
+}
+
+// Shader problems name the file, the driver's log, or the folders searched.
+class ShaderFolder : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("gtrack_gl_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_ / "shaders");
+    fs::create_directories(dir_ / "empty");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(ShaderFolder, AMissingShaderListsThePathsSearched) {
+  ScopedEnv shaders("GTRACK_SHADER_DIR", (dir_ / "shaders").string());
+  ScopedEnv data("GTRACK_DATA_DIR", (dir_ / "empty").string());
+  try {
+    std::string skip;
+    auto r = make_gl(skip);
+    if (!r) GTEST_SKIP() << skip;
+    ADD_FAILURE() << "made a renderer without shaders";
+  } catch (const gtrack::Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("not found"), std::string::npos) << m;
+    EXPECT_NE(m.find((dir_ / "shaders").string()), std::string::npos) << m;
+    EXPECT_NE(m.find((dir_ / "empty" / "shaders").string()), std::string::npos) << m;
+  }
+}
+
+TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndCarriesTheLog) {
+  const fs::path source = fs::path(GTRACK_TEST_SOURCE_DIR) / "shaders";
+  for (const auto& f : fs::directory_iterator(source)) fs::copy_file(f.path(), dir_ / "shaders" / f.path().filename());
+  std::ofstream(dir_ / "shaders" / "hypotheses.frag", std::ios::app) << "\nthis is not glsl;\n";
+  ScopedEnv shaders("GTRACK_SHADER_DIR", (dir_ / "shaders").string());
+  try {
+    std::string skip;
+    auto r = make_gl(skip);
+    if (!r) GTEST_SKIP() << skip;
+    ADD_FAILURE() << "a broken shader compiled";
+  } catch (const gtrack::Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("hypotheses.frag"), std::string::npos) << m;
+    EXPECT_NE(m.find("compile"), std::string::npos) << m;
+    EXPECT_NE(m.find("error"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+}  // namespace

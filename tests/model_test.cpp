@@ -1,0 +1,126 @@
+// The articulated model against hand-computed geometry (hydrogel gripper).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "support/plugins.hpp"
+
+using gtrack::testing::make_gripper;
+
+namespace {
+
+Eigen::VectorXd hyp(std::initializer_list<double> pose, double q) {
+  Eigen::VectorXd h(12);
+  int i = 0;
+  for (double v : pose) h[i++] = v;
+  for (; i < 12; ++i) h[i] = q;
+  return h;
+}
+
+TEST(HydrogelModel, HasThePapersShape) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  EXPECT_EQ(m.triangles(), 46);
+  EXPECT_EQ(m.dims(), 12);
+  EXPECT_EQ(m.fingers(), 6);
+  EXPECT_EQ(m.geometry().symmetry_order, 6);
+  // 4 mm tip to tip when open.
+  auto tips = m.fingertips(hyp({0, 0, 0, 0, 0, 0}, 0));
+  EXPECT_NEAR((tips[0] - tips[3]).norm(), 4.0, 1e-9);
+  EXPECT_NEAR(m.radius_mm(), 2.0, 1e-9);
+}
+
+TEST(HydrogelModel, FingertipsMatchHandComputedValues) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  // Open: tips on a 2 mm circle every 60 degrees.
+  auto tips = m.fingertips(hyp({0, 0, 0, 0, 0, 0}, 0));
+  for (int f = 0; f < 6; ++f) {
+    const double a = f * M_PI / 3;
+    EXPECT_NEAR(tips[f].x(), 2.0 * std::cos(a), 1e-9);
+    EXPECT_NEAR(tips[f].y(), 2.0 * std::sin(a), 1e-9);
+    EXPECT_NEAR(tips[f].z(), 0.0, 1e-12);
+  }
+  // q = 90: links at 90, 180, 270, 360 deg: the tip ends 0.05 mm inside the
+  // palm edge (0.65 - 0.35 + 0.30), back in the palm plane.
+  tips = m.fingertips(hyp({0, 0, 0, 0, 0, 0}, 90));
+  EXPECT_NEAR(tips[0].x(), 0.60, 1e-9);
+  EXPECT_NEAR(tips[0].z(), 0.0, 1e-9);
+  // q = 30 with a pose: r = 0.35(cos30+cos60+cos90) + 0.30 cos120,
+  // z = 0.35(sin30+sin60+sin90) + 0.30 sin120; rotated by rz = 90, moved by (1, 2, 50).
+  tips = m.fingertips(hyp({1, 2, 50, 0, 0, 90}, 30));
+  const double r = 0.65 + 0.35 * (std::sqrt(3) / 2 + 0.5 + 0) + 0.30 * -0.5;
+  const double z = 0.35 * (0.5 + std::sqrt(3) / 2 + 1) + 0.30 * std::sqrt(3) / 2;
+  EXPECT_NEAR(tips[0].x(), 1.0, 1e-9);
+  EXPECT_NEAR(tips[0].y(), 2.0 + r, 1e-9);
+  EXPECT_NEAR(tips[0].z(), 50.0 + z, 1e-9);
+  // Fingers fold towards +Z of the model: with rx = 180 they fold towards -Z.
+  tips = m.fingertips(hyp({0, 0, 10, 180, 0, 0}, 30));
+  EXPECT_NEAR(tips[0].z(), 10.0 - z, 1e-9);
+}
+
+TEST(HydrogelModel, PoseMatchesEndpointsAndEuler) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  Eigen::VectorXd h = hyp({0.3, -0.2, 40, 20, -35, 110}, 25);
+  std::vector<Eigen::Vector3d> verts;
+  m.pose(h, verts);
+  ASSERT_EQ(verts.size(), 46u * 3);
+  // Every vertex is at the same distance from the palm centre as in the model frame.
+  std::vector<Eigen::Vector3d> local;
+  m.pose_model(std::span<const double>(h.data() + 6, 6), local);
+  for (size_t i = 0; i < verts.size(); ++i) {
+    EXPECT_NEAR((verts[i] - h.head<3>()).norm(), local[i].norm(), 1e-9);
+  }
+  // Euler round trip.
+  Eigen::Matrix3d R = gtrack::rotation_from_euler_deg(20, -35, 110);
+  Eigen::Vector3d e = gtrack::euler_deg_from_rotation(R);
+  EXPECT_NEAR(e.x(), 20, 1e-9);
+  EXPECT_NEAR(e.y(), -35, 1e-9);
+  EXPECT_NEAR(e.z(), 110, 1e-9);
+}
+
+TEST(HydrogelModel, SymmetricEquivalentDescribesTheSameShape) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  Eigen::VectorXd h(12);
+  h << 0.1, 0.2, 30, 15, -20, 40, 5, 10, 20, 30, 40, 50;
+  for (int k = 1; k < 6; ++k) {
+    Eigen::VectorXd e = m.symmetric_equivalent(h, k);
+    EXPECT_GT((e - h).norm(), 1.0);
+    // Same set of fingertips.
+    auto a = m.fingertips(h), b = m.fingertips(e);
+    for (const auto& p : a) {
+      double best = 1e9;
+      for (const auto& q : b) best = std::min(best, (p - q).norm());
+      EXPECT_LT(best, 1e-9) << "k=" << k;
+    }
+    // Every phalanx endpoint too (the finger carrying the same joint value lands there).
+    auto ea = m.link_endpoints(h), eb = m.link_endpoints(e);
+    for (const auto& p : ea) {
+      double best = 1e9;
+      for (const auto& q : eb) best = std::min(best, (p - q).norm());
+      EXPECT_LT(best, 1e-9) << "k=" << k;
+    }
+  }
+}
+
+TEST(HydrogelModel, KinematicPenaltyFollowsTheRules) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"\nmax_adjacent_difference_deg = 40");
+  std::vector<double> ok{10, 20, 30, 40, 50, 60};  // neighbours differ by 10, but fingers 6 and 1 by 50
+  std::vector<double> fine{30, 30, 30, 30, 30, 30};
+  EXPECT_EQ(g->kinematic_penalty(fine), 0.0);
+  EXPECT_GT(g->kinematic_penalty(ok), 0.0);  // fingers 6 and 1 differ by 50 > 40
+  std::vector<double> beyond{85, 85, 85, 85, 85, 85};  // above joint_max 80
+  EXPECT_NEAR(g->kinematic_penalty(beyond), 6 * 5.0 / 90.0, 1e-12);
+}
+
+TEST(HydrogelModel, ConfigOverridesAreValidated) {
+  EXPECT_THROW(make_gripper("plugin = \"hydrogel_six_finger\"\nlink_widths_mm = [1, 2]"), gtrack::ConfigError);
+  EXPECT_THROW(make_gripper("plugin = \"hydrogel_six_finger\"\njoint_min_deg = 50\njoint_max_deg = 40"),
+               gtrack::ConfigError);
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"\nlink_lengths_mm = [0.5, 0.5]\nlink_widths_mm = [0.5, 0.4, 0]");
+  EXPECT_EQ(g->model().triangles(), 4 + 6 * 3);
+}
+
+}  // namespace

@@ -1,0 +1,138 @@
+// The loader: one error per way a plugin can be wrong, and object lifetime.
+#include <gtest/gtest.h>
+
+#include <boost/dll/shared_library.hpp>
+#include <dlfcn.h>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <gtrack/error.hpp>
+#include <gtrack/plugin_loader.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kFixtures = GTRACK_TEST_FIXTURE_DIR;
+
+std::string plugin_error(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const gtrack::PluginError& e) {
+    return e.what();
+  } catch (const gtrack::Error& e) {
+    return std::string("other gtrack error: ") + e.what();
+  }
+  return "";
+}
+
+gtrack::ConfigTable table(const std::string& name, const std::string& section = "sensor") {
+  auto root = gtrack::ConfigTable::parse("[" + section + "]\nplugin = \"" + name + "\"\n", "t.toml");
+  return root.table(section);
+}
+
+TEST(PluginLoader, DiscoversTheBuiltInPlugins) {
+  gtrack::PluginLoader loader;
+  auto records = loader.discover();
+  std::map<std::string, gtrack::PluginKind> found;
+  for (const auto& r : records) found[r.name] = r.kind;
+  EXPECT_EQ(found.at("pinhole_microscope"), gtrack::PluginKind::Sensor);
+  EXPECT_EQ(found.at("hydrogel_six_finger"), gtrack::PluginKind::Gripper);
+  EXPECT_EQ(found.at("temperature_hysteresis"), gtrack::PluginKind::Stimulus);
+  for (const auto& r : records) EXPECT_TRUE(fs::exists(r.file)) << r.file;
+}
+
+TEST(PluginLoader, NotFoundListsPathsAndAvailablePlugins) {
+  gtrack::PluginLoader loader({"/nonexistent/dir"});
+  std::string e = plugin_error([&] { loader.make_sensor(table("pinhole_microscop")); });
+  EXPECT_NE(e.find("sensor plugin 'pinhole_microscop' not found"), std::string::npos) << e;
+  EXPECT_NE(e.find("/nonexistent/dir"), std::string::npos) << e;
+  EXPECT_NE(e.find("available sensor plugins: pinhole_microscope"), std::string::npos) << e;
+  EXPECT_EQ(e.find("hydrogel"), std::string::npos) << "lists only plugins of the kind asked for: " << e;
+}
+
+TEST(PluginLoader, RefusesAnAbiMismatchBeforeCallingAnything) {
+  gtrack::PluginLoader loader({kFixtures});
+  // The fixture's factory aborts; reaching it would kill the test.
+  std::string e = plugin_error([&] { loader.make_sensor(table("fixture_bad_abi")); });
+  EXPECT_NE(e.find("plugin ABI version " + std::to_string(GTRACK_PLUGIN_ABI_VERSION + 41)), std::string::npos) << e;
+  EXPECT_NE(e.find("this gtrack's plugin ABI version " + std::to_string(GTRACK_PLUGIN_ABI_VERSION)),
+            std::string::npos)
+      << e;
+}
+
+TEST(PluginLoader, RefusesAnInfoRecordOfAnotherLayout) {
+  gtrack::PluginLoader loader({kFixtures});
+  std::string e = plugin_error([&] { loader.make_sensor(table("fixture_bad_size")); });
+  EXPECT_NE(e.find("info record has size"), std::string::npos) << e;
+}
+
+TEST(PluginLoader, NotAGtrackPlugin) {
+  gtrack::PluginLoader loader({kFixtures});
+  std::string e = plugin_error([&] { loader.make_sensor(table("fixture_not_a_plugin")); });
+  EXPECT_NE(e.find("not a gtrack plugin"), std::string::npos) << e;
+}
+
+TEST(PluginLoader, WrongKind) {
+  gtrack::PluginLoader loader({kFixtures});
+  std::string e = plugin_error([&] { loader.make_gripper(table("fixture_wrong_kind", "gripper")); });
+  EXPECT_NE(e.find("is a sensor plugin; [gripper] needs a gripper plugin"), std::string::npos) << e;
+}
+
+TEST(PluginLoader, FactoryThrowsGivesItsMessage) {
+  gtrack::PluginLoader loader({kFixtures});
+  std::string e = plugin_error([&] { loader.make_sensor(table("fixture_throwing_factory")); });
+  EXPECT_NE(e.find("could not be created: calibration file missing"), std::string::npos) << e;
+}
+
+TEST(PluginLoader, CannotLoadIsReported) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_loader_test";
+  fs::create_directories(dir);
+  { std::ofstream(dir / "libgtrack_garbage.so") << "not an ELF file"; }
+  gtrack::PluginLoader loader({dir});
+  std::string e = plugin_error([&] { loader.make_sensor(table("garbage")); });
+  EXPECT_NE(e.find("cannot load library"), std::string::npos) << e;
+  // Discovery skips it rather than failing.
+  EXPECT_NO_THROW(loader.discover());
+}
+
+TEST(PluginLoader, UnknownKeyInThePluginTable) {
+  gtrack::PluginLoader loader({kFixtures});
+  auto root = gtrack::ConfigTable::parse("[sensor]\nplugin = \"fixture_good_sensor\"\nsise = 3\n", "k.toml");
+  try {
+    loader.make_sensor(root.table("sensor"));
+    FAIL() << "unknown key accepted";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("k.toml:3: key 'sensor.sise'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("did you mean 'size'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PluginLoader, InstanceKeepsItsLibraryLoaded) {
+  std::shared_ptr<gtrack::Sensor> sensor;
+  {
+    gtrack::PluginLoader loader({kFixtures});
+    sensor = loader.make_sensor(table("fixture_good_sensor"));
+  }
+  // The loader is gone; the instance's code must still be mapped.
+  EXPECT_EQ(sensor->image_size().width, 64);
+  const fs::path lib = kFixtures / "libgtrack_fixture_good_sensor.so";
+  EXPECT_TRUE(boost::dll::shared_library(lib, static_cast<boost::dll::load_mode::type>(RTLD_NOLOAD)).is_loaded());
+  sensor.reset();
+}
+
+TEST(PluginLoader, SearchOrderPutsUserPathsFirst) {
+  ::setenv("GTRACK_PLUGIN_PATH", "/env/a:/env/b", 1);
+  gtrack::PluginLoader loader({"/user/1"});
+  loader.add_path("/config/2");
+  ::unsetenv("GTRACK_PLUGIN_PATH");
+  const auto& p = loader.search_paths();
+  ASSERT_EQ(p.size(), 5u);
+  EXPECT_EQ(p[0], "/user/1");
+  EXPECT_EQ(p[1], "/config/2");
+  EXPECT_EQ(p[2], "/env/a");
+  EXPECT_EQ(p[3], "/env/b");
+  EXPECT_EQ(p[4], gtrack::default_plugin_dir());
+}
+
+}  // namespace

@@ -1,0 +1,91 @@
+// temperature_hysteresis against the paper's rules (Sections 2.2, 3, 5).
+#include <gtest/gtest.h>
+
+#include "support/plugins.hpp"
+
+using gtrack::testing::make_stimulus;
+
+namespace {
+
+const char* kHydrogel = "plugin = \"temperature_hysteresis\"";
+const char* kMetallic =
+    "plugin = \"temperature_hysteresis\"\nmode = \"latching\"\ntrigger_C = 37\nfolded_deg = 70\ntolerance_deg = 8";
+
+void ramp(gtrack::Stimulus& s, double from, double to, int steps, double t0 = 0, double dt = 1) {
+  for (int i = 0; i <= steps; ++i) s.update(from + (to - from) * i / steps, t0 + i * dt);
+}
+
+TEST(TemperatureHysteresis, HeatingInTheFoldingRangeBiasesThreeQuartersTowardsFolding) {
+  auto s = make_stimulus(kHydrogel);
+  ramp(*s, 23.0, 25.5, 20);
+  EXPECT_EQ(s->state().trend, gtrack::StimulusTrend::Folding);
+  EXPECT_TRUE(s->state().in_transition);
+  EXPECT_DOUBLE_EQ(s->fold_fraction(), 0.75);
+}
+
+TEST(TemperatureHysteresis, CoolingInTheRangeBiasesTowardsUnfolding) {
+  auto s = make_stimulus(kHydrogel);
+  ramp(*s, 29.0, 25.5, 20);
+  EXPECT_EQ(s->state().trend, gtrack::StimulusTrend::Unfolding);
+  EXPECT_DOUBLE_EQ(s->fold_fraction(), 0.25);
+}
+
+TEST(TemperatureHysteresis, OtherwiseHalfAndHalf) {
+  auto s = make_stimulus(kHydrogel);
+  ramp(*s, 20.0, 20.0, 10);  // steady, outside the range
+  EXPECT_DOUBLE_EQ(s->fold_fraction(), 0.5);
+  auto h = make_stimulus(kHydrogel);
+  ramp(*h, 30.0, 33.0, 10);  // heating, but far above the range
+  EXPECT_FALSE(h->state().in_transition);
+  EXPECT_DOUBLE_EQ(h->fold_fraction(), 0.5);
+}
+
+TEST(TemperatureHysteresis, PenaltyIsTheMeanAbsoluteErrorOfInfeasibleJoints) {
+  auto s = make_stimulus(kHydrogel);
+  ramp(*s, 30.0, 30.0, 3);  // hot: folded (60 +- 10)
+  std::vector<double> folded{60, 55, 65, 70, 50, 62};
+  EXPECT_DOUBLE_EQ(s->penalty(folded), 0.0);
+  std::vector<double> two_open{0, 30, 60, 60, 60, 60};  // 0 and 30 infeasible: MAE = (60 + 30)/2 = 45 deg
+  EXPECT_NEAR(s->penalty(two_open), 45.0 / 60.0, 1e-12);
+  auto c = make_stimulus(kHydrogel);
+  ramp(*c, 20.0, 20.0, 3);  // cold: unfolded (0 +- 10)
+  EXPECT_DOUBLE_EQ(c->penalty(std::vector<double>(6, 5.0)), 0.0);
+  EXPECT_NEAR(c->penalty(std::vector<double>{60, 0, 0, 0, 0, 0}), 1.0, 1e-12);
+  // In the transition band every value between the references is feasible.
+  auto m = make_stimulus(kHydrogel);
+  ramp(*m, 25.0, 26.0, 5);
+  EXPECT_DOUBLE_EQ(m->penalty(std::vector<double>{0, 10, 30, 45, 60, 65}), 0.0);
+  EXPECT_GT(m->penalty(std::vector<double>{0, 10, 30, 45, 60, 95}), 0.0);
+}
+
+TEST(TemperatureHysteresis, HysteresisDrivesTheSimulatedJoint) {
+  auto s = make_stimulus(kHydrogel);
+  ramp(*s, 24.0, 25.5, 10);  // heating half-way through the band
+  EXPECT_NEAR(s->target_joint_deg(0.0), 30.0, 1e-9);
+  EXPECT_NEAR(s->target_joint_deg(50.0), 50.0, 1e-9);  // heating never unfolds
+  ramp(*s, 25.5, 25.0, 10, 20);  // cooling slightly
+  EXPECT_NEAR(s->target_joint_deg(50.0), 20.0, 1e-9);
+  EXPECT_NEAR(s->target_joint_deg(10.0), 10.0, 1e-9);  // cooling never folds
+}
+
+TEST(TemperatureHysteresis, MetallicGrippersFoldAtTriggerAndNeverUnfold) {
+  auto s = make_stimulus(kMetallic);
+  ramp(*s, 25.0, 36.0, 10);
+  EXPECT_GT(s->penalty(std::vector<double>(6, 70.0)), 0.0);  // cannot be folded before 37 C
+  EXPECT_DOUBLE_EQ(s->target_joint_deg(0.0), 0.0);
+  ramp(*s, 36.0, 38.0, 5, 20);
+  EXPECT_DOUBLE_EQ(s->target_joint_deg(0.0), 70.0);
+  EXPECT_DOUBLE_EQ(s->fold_fraction(), 0.75);
+  ramp(*s, 38.0, 25.0, 10, 40);  // cooled again: stays folded
+  EXPECT_DOUBLE_EQ(s->penalty(std::vector<double>(6, 70.0)), 0.0);
+  EXPECT_DOUBLE_EQ(s->target_joint_deg(70.0), 70.0);
+}
+
+TEST(TemperatureHysteresis, BadTablesAreRejected) {
+  EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nmode = \"sometimes\""), gtrack::ConfigError);
+  EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nunfold_below_C = 30\nfold_above_C = 20"),
+               gtrack::ConfigError);
+  EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nfold_bias = 2"), gtrack::ConfigError);
+}
+
+}  // namespace

@@ -1,0 +1,1 @@
+// Keeps gtrack_test_support a valid library when tests/support is empty.

@@ -1,0 +1,339 @@
+// The tracker end to end on small synthetic scenes: coarse search, frame to
+// frame tracking, files written by track_sequence, interruption, bad inputs.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "gtrack/engine_config.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/tracker.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// 256x256 microscope: the 4 mm gripper is ~128 px across at 100 mm.
+const char* kConfig = R"(
+[sensor]
+plugin = "pinhole_microscope"
+width = 256
+height = 256
+fx = 3200.0
+working_distance_mm = 100.0
+[gripper]
+plugin = "hydrogel_six_finger"
+[stimulus]
+plugin = "temperature_hysteresis"
+[render]
+backend = "cpu"
+scale = 0.5
+threads = 2
+[search]
+position_min_mm = [-3.0, -3.0, 98.0]
+position_max_mm = [3.0, 3.0, 102.0]
+)";
+
+gtrack::Setup make_setup(const std::string& extra = "") {
+  return gtrack::load_setup(gtrack::ConfigTable::parse(std::string(kConfig) + extra, "<test>"), {});
+}
+
+// A camera frame of the gripper at h: red-ish gripper on a grey, noisy background.
+cv::Mat scene(const gtrack::Setup& setup, const Eigen::VectorXd& h, std::uint64_t seed) {
+  gtrack::RenderOptions ro;
+  ro.backend = "cpu";
+  ro.scale = 1.0;
+  auto r = gtrack::make_cpu_renderer(ro);
+  r->set_model(setup.model());
+  r->set_projection(setup.sensor->projection(), 1.0);
+  const cv::Mat mask = r->render_mask(h);
+  cv::Mat img(mask.size(), CV_8UC3, cv::Scalar(120, 125, 130));
+  cv::Mat noise(mask.size(), CV_8UC3);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 6);
+  img.setTo(cv::Scalar(60, 70, 200), mask);
+  cv::add(img, noise, img);
+  return img;
+}
+
+Eigen::VectorXd pose(double x, double y, double rz, double q) {
+  Eigen::VectorXd h(12);
+  h << x, y, 100.0, 8, -6, rz, q, q, q, q, q, q;
+  return h;
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::path(GTRACK_TEST_BINARY_DIR) / "test_tmp" / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+std::vector<std::string> lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+int fields(const std::string& line) { return static_cast<int>(std::count(line.begin(), line.end(), ',')) + 1; }
+
+// A sequence on disk: frames/NNNNNN.png and stimulus.csv (heating 22 -> 30 C).
+fs::path write_sequence(const std::string& name, int frames) {
+  const fs::path dir = temp_dir(name);
+  fs::create_directories(dir / "frames");
+  const auto setup = make_setup();
+  std::ofstream csv(dir / "stimulus.csv");
+  csv << "frame,value\n";
+  for (int i = 0; i < frames; ++i) {
+    char n[32];
+    std::snprintf(n, sizeof n, "%06d.png", i);
+    cv::imwrite((dir / "frames" / n).string(), scene(setup, pose(0.3 + 0.03 * i, -0.2, 20 + i, 5 + i), i + 1));
+    csv << i << "," << 22.0 + 8.0 * i / std::max(1, frames - 1) << "\n";
+  }
+  return dir;
+}
+
+TEST(Tracker, CoarseSearchFindsTheGripperOnTheFirstFrame) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  gtrack::Tracker tracker(setup, config);
+  const Eigen::VectorXd truth = pose(0.4, -0.3, 25, 15);
+  const auto e = tracker.process(scene(setup, truth, 1), 0, 0.0, 22.0);
+  EXPECT_EQ(e.status, gtrack::TrackStatus::Search);
+  EXPECT_LT(e.terms.dice, 0.12) << e.hypothesis.transpose();
+  EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.06) << e.hypothesis.transpose();
+  EXPECT_GT(e.evaluations, 800u);
+}
+
+TEST(Tracker, FollowsAMovingFoldingGripper) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  gtrack::Tracker tracker(setup, config);
+  tracker.set_estimate(pose(0.3, -0.2, 20, 5));
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::VectorXd truth = pose(0.3 + 0.03 * i, -0.2, 20 + i, 5 + 2 * i);
+    const auto e = tracker.process(scene(setup, truth, i + 1), i, i / 30.0, 22.0 + i);
+    EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
+    EXPECT_EQ(e.evaluations, 32u * 25u);
+    EXPECT_LT(e.terms.dice, 0.12) << "frame " << i;
+    EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
+  }
+}
+
+TEST(Tracker, NothingDetectedIsLostNotAnError) {
+  auto setup = make_setup();
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  tracker.set_estimate(pose(0.3, -0.2, 20, 5));
+  const cv::Mat empty(256, 256, CV_8UC3, cv::Scalar(120, 125, 130));
+  const auto e = tracker.process(empty, 0, 0.0, std::nullopt);
+  EXPECT_EQ(e.status, gtrack::TrackStatus::Lost);
+  EXPECT_EQ(e.observed_pixels, 0u);
+  EXPECT_EQ(e.hypothesis, pose(0.3, -0.2, 20, 5));  // held
+}
+
+TEST(Tracker, SameSeedSameEstimates) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  const cv::Mat frame = scene(setup, pose(0.1, 0.1, 10, 10), 3);
+  gtrack::Tracker a(setup, config), b(setup, config);
+  a.set_estimate(pose(0.12, 0.08, 12, 8));
+  b.set_estimate(pose(0.12, 0.08, 12, 8));
+  EXPECT_EQ(a.process(frame, 4, 0.1, 23.0).hypothesis, b.process(frame, 4, 0.1, 23.0).hypothesis);
+}
+
+TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
+  const fs::path seq = write_sequence("seq_files", 5);
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  gtrack::TrackOptions opt;
+  opt.input = (seq / "frames").string();
+  opt.stimulus_csv = seq / "stimulus.csv";
+  opt.out_dir = seq / "out";
+  opt.save_masks = true;
+  opt.progress = false;
+  const auto s = gtrack::track_sequence(setup, config, opt);
+  EXPECT_EQ(s.frames, 5);
+  EXPECT_EQ(s.lost_frames, 0);
+  const auto csv = lines(opt.out_dir / "estimates.csv");
+  ASSERT_EQ(csv.size(), 6u);
+  EXPECT_EQ(csv[0], "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,cost,status,ms");
+  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(fields(csv[i]), 16) << csv[i];
+  EXPECT_NE(csv[1].find(",search,"), std::string::npos);
+  EXPECT_NE(csv[2].find(",ok,"), std::string::npos);
+  const auto jsonl = lines(opt.out_dir / "estimates.jsonl");
+  ASSERT_EQ(jsonl.size(), 5u);
+  EXPECT_NE(jsonl[4].find("\"stimulus\":30.0000"), std::string::npos) << jsonl[4];
+  EXPECT_NE(jsonl[0].find("\"D\":"), std::string::npos);
+  EXPECT_TRUE(fs::exists(opt.out_dir / "summary.json"));
+  EXPECT_TRUE(fs::exists(opt.out_dir / "masks" / "000004.png"));
+  EXPECT_FALSE(s.overlay_file.empty());
+  EXPECT_GT(fs::file_size(s.overlay_file), 0u);
+}
+
+TEST(TrackSequence, EveryAndFramesSelectSourceIndices) {
+  const fs::path seq = write_sequence("seq_range", 6);
+  auto setup = make_setup();
+  gtrack::TrackOptions opt;
+  opt.input = (seq / "frames").string();
+  opt.out_dir = seq / "out";
+  opt.range = gtrack::parse_frame_range("1:6");
+  opt.range.every = 2;
+  opt.overlay = false;
+  opt.progress = false;
+  gtrack::track_sequence(setup, gtrack::engine_config(setup), opt);
+  const auto csv = lines(opt.out_dir / "estimates.csv");
+  ASSERT_EQ(csv.size(), 4u);
+  EXPECT_EQ(csv[1].substr(0, 2), "1,");
+  EXPECT_EQ(csv[2].substr(0, 2), "3,");
+  EXPECT_EQ(csv[3].substr(0, 2), "5,");
+}
+
+TEST(TrackSequence, CancellationKeepsValidFiles) {
+  const fs::path seq = write_sequence("seq_cancel", 5);
+  auto setup = make_setup();
+  std::atomic<bool> stop{false};
+  gtrack::TrackOptions opt;
+  opt.input = (seq / "frames").string();
+  opt.out_dir = seq / "out";
+  opt.progress = false;
+  opt.cancel = &stop;
+  opt.on_frame = [&](const gtrack::Estimate& e) {
+    if (e.frame == 1) stop = true;
+  };
+  const auto s = gtrack::track_sequence(setup, gtrack::engine_config(setup), opt);
+  EXPECT_TRUE(s.cancelled);
+  EXPECT_EQ(s.frames, 2);
+  EXPECT_EQ(lines(opt.out_dir / "estimates.csv").size(), 3u);
+  EXPECT_EQ(lines(opt.out_dir / "estimates.jsonl").size(), 2u);
+  const auto summary = lines(opt.out_dir / "summary.json");
+  EXPECT_NE(std::find(summary.begin(), summary.end(), "  \"cancelled\": true"), summary.end());
+}
+
+// SIGINT to a real `gtrack track` process: it finishes the frame, closes the
+// files and exits with 130; every row written is complete.
+TEST(TrackCommand, SigintLeavesCompleteRows) {
+  const fs::path seq = write_sequence("seq_sigint", 40);
+  const fs::path cfg = seq / "config.toml";
+  std::ofstream(cfg) << kConfig;
+  const fs::path out = seq / "out";
+  const std::string exe = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string input = (seq / "frames").string(), outs = out.string(), cfgs = cfg.string(),
+                      stim = (seq / "stimulus.csv").string();
+    execl(exe.c_str(), exe.c_str(), "track", "--config", cfgs.c_str(), "--input", input.c_str(), "--stimulus",
+          stim.c_str(), "--out", outs.c_str(), "--log-level", "warn", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait for the second finished frame, then interrupt.
+  const auto t0 = std::chrono::steady_clock::now();
+  while (lines(out / "estimates.csv").size() < 3 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const auto csv = lines(out / "estimates.csv");
+  const auto jsonl = lines(out / "estimates.jsonl");
+  EXPECT_GE(csv.size(), 3u);
+  EXPECT_LT(csv.size(), 41u);
+  EXPECT_EQ(jsonl.size() + 1, csv.size());
+  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(fields(csv[i]), 16);
+  for (const auto& j : jsonl) EXPECT_TRUE(j.front() == '{' && j.back() == '}') << j;
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+}
+
+TEST(TrackSequence, WrongImageSizeNamesFileAndSizes) {
+  const fs::path dir = temp_dir("wrong_size");
+  cv::imwrite((dir / "a.png").string(), cv::Mat(100, 120, CV_8UC3, cv::Scalar(0, 0, 0)));
+  auto setup = make_setup();
+  gtrack::TrackOptions opt;
+  opt.input = dir.string();
+  opt.out_dir = dir / "out";
+  opt.progress = false;
+  try {
+    gtrack::track_sequence(setup, gtrack::engine_config(setup), opt);
+    FAIL() << "expected InputError";
+  } catch (const gtrack::InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("a.png"), std::string::npos) << m;
+    EXPECT_NE(m.find("120x100"), std::string::npos) << m;
+    EXPECT_NE(m.find("256x256"), std::string::npos) << m;
+  }
+}
+
+TEST(TrackSequence, BadInputsAreInputErrors) {
+  const fs::path dir = temp_dir("bad_inputs");
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  gtrack::TrackOptions opt;
+  opt.out_dir = dir / "out";
+  opt.progress = false;
+  fs::create_directories(dir / "empty");
+  opt.input = (dir / "empty").string();
+  EXPECT_THROW(gtrack::track_sequence(setup, config, opt), gtrack::InputError);
+  opt.input = (dir / "missing.mp4").string();
+  EXPECT_THROW(gtrack::track_sequence(setup, config, opt), gtrack::InputError);
+  std::ofstream(dir / "corrupt.avi") << "this is not a video";
+  opt.input = (dir / "corrupt.avi").string();
+  EXPECT_THROW(gtrack::track_sequence(setup, config, opt), gtrack::InputError);
+  // An output folder below a regular file cannot be created.
+  const fs::path seq = write_sequence("seq_unwritable", 1);
+  std::ofstream(dir / "file") << "x";
+  opt.input = (seq / "frames").string();
+  opt.out_dir = dir / "file" / "out";
+  EXPECT_THROW(gtrack::track_sequence(setup, config, opt), gtrack::InputError);
+}
+
+TEST(EngineConfig, PaperDefaults) {
+  auto setup = make_setup();
+  const auto c = gtrack::engine_config(setup);
+  EXPECT_EQ(c.pso.particles, 32);
+  EXPECT_EQ(c.pso.generations, 25);
+  EXPECT_DOUBLE_EQ(c.pso.inertia, 0.4);
+  EXPECT_DOUBLE_EQ(c.pso.c, 1.0);
+  EXPECT_EQ(c.pso.randomize_every, 8);
+  EXPECT_DOUBLE_EQ(c.cost.dice, 2.0);
+  EXPECT_DOUBLE_EQ(c.cost.kinematic, 0.15);
+  EXPECT_DOUBLE_EQ(c.cost.stimulus, 1.0);
+  EXPECT_EQ(c.space.dims(), 12);
+  EXPECT_TRUE(c.space.periodic[5]);
+}
+
+TEST(EngineConfig, UnknownKeyNamesFileLineAndSuggestion) {
+  auto setup = make_setup("[pso]\nparticels = 16\n");
+  try {
+    gtrack::engine_config(setup);
+    FAIL() << "expected ConfigError";
+  } catch (const gtrack::ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("particels"), std::string::npos) << m;
+    EXPECT_NE(m.find("particles"), std::string::npos) << m;
+    EXPECT_NE(m.find("<test>:"), std::string::npos) << m;
+  }
+}
+
+TEST(EngineConfig, UnknownTableIsAnError) {
+  auto setup = make_setup("[tracer]\nfps = 10\n");
+  gtrack::engine_config(setup);
+  EXPECT_THROW(gtrack::check_root_keys(setup), gtrack::ConfigError);
+}
+
+TEST(EngineConfig, InitialPoseMustHaveEveryParameter) {
+  auto setup = make_setup("[tracker]\ninitial_pose = [0.0, 0.0, 100.0]\n");
+  EXPECT_THROW(gtrack::engine_config(setup), gtrack::ConfigError);
+}
+
+}  // namespace
