@@ -4,12 +4,30 @@
 #include <gtrack/error.hpp>
 #include <gtrack/renderer.hpp>
 
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <opencv2/core.hpp>
 #include <random>
 #include <string>
 
 #include "support/reference_raster.hpp"
+
+// Counts heap allocations while `counting` is set, in every thread and in
+// the framework library too (it calls the replaceable global operator new).
+namespace {
+std::atomic<bool> counting{false};
+std::atomic<long> allocations{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -286,6 +304,23 @@ TEST(CpuRenderer, ThreadsGiveTheSameCountsAsOneThread) {
       }
     }
   }
+}
+
+TEST(CpuRenderer, NothingIsAllocatedPerBatchAfterWarmUp) {
+  const ArticulatedModel model(hydrogel_geometry());
+  const Projection full = camera();
+  auto r = cpu(model, full, kScale, 2);
+  r->set_observation(reference_mask(model, gtrack::scaled_projection(full, kScale), random_hypotheses(1, 3, 6).col(0)));
+  const Eigen::MatrixXd H = random_hypotheses(64, 23, 6);
+  const Eigen::MatrixXd a = H.leftCols(32), b = H.rightCols(32);
+  std::vector<PairCounts> out;
+  r->evaluate(a, out);
+  r->evaluate(b, out);
+  allocations = 0;
+  counting = true;
+  for (int k = 0; k < 20; ++k) r->evaluate(k % 2 ? a : b, out);
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0);
 }
 
 TEST(CpuRenderer, SubmitThenFinishAndEmptyBatches) {

@@ -337,3 +337,30 @@ TEST(EngineConfig, InitialPoseMustHaveEveryParameter) {
 }
 
 }  // namespace
+
+namespace {
+
+// Not part of the suite (slow-ish): how often the coarse search lands on
+// random poses. Run with --gtest_also_run_disabled_tests.
+TEST(Tracker, DISABLED_CoarseSearchOnRandomPoses) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> xy(-1, 1), tilt(-30, 30), rz(-180, 180), q(0, 60);
+  int good = 0;
+  for (int i = 0; i < 20; ++i) {
+    Eigen::VectorXd h(12);
+    h << xy(rng), xy(rng), 100.0, tilt(rng), tilt(rng), rz(rng), 0, 0, 0, 0, 0, 0;
+    h.tail(6).setConstant(q(rng));
+    gtrack::Tracker tracker(setup, config);
+    const auto e = tracker.process(scene(setup, h, i), i, 0.0, std::nullopt);
+    const double pos = (e.hypothesis.head<2>() - h.head<2>()).norm() * 1000;
+    std::printf("pose %2d: D %.3f  xy err %.0f um  q %.0f->%.0f  tilt (%.0f,%.0f)->(%.0f,%.0f)  %.0f ms\n", i,
+                e.terms.dice, pos, h[6], e.hypothesis.tail(6).mean(), h[3], h[4], e.hypothesis[3], e.hypothesis[4],
+                e.ms);
+    good += e.terms.dice < 0.15;
+  }
+  std::printf("%d/20 with D < 0.15\n", good);
+}
+
+}  // namespace

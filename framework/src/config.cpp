@@ -161,6 +161,19 @@ std::vector<std::string> ConfigTable::keys() const {
 void ConfigTable::mark_used(std::string_view key) const { impl_->used->insert(std::string(key)); }
 
 namespace {
+// "missing; expected X", plus the likely misspelling when the table has an
+// unread key close to the one asked for.
+std::string missing_message(const ConfigTable::Impl& impl, std::string_view key, const std::string& expected) {
+  std::string msg = "missing; " + expected;
+  if (!impl.table) return msg;
+  std::vector<std::string> unread;
+  for (auto&& [k, v] : *impl.table) {
+    if (!impl.used->count(std::string(k.str()))) unread.emplace_back(k.str());
+  }
+  if (auto m = closest_match(key, unread)) msg += " (is '" + *m + "' a misspelling of it?)";
+  return msg;
+}
+
 const toml::node* lookup(const ConfigTable::Impl& impl, std::string_view key) {
   impl.used->insert(std::string(key));
   return impl.table ? impl.table->get(key) : nullptr;
@@ -169,7 +182,7 @@ const toml::node* lookup(const ConfigTable::Impl& impl, std::string_view key) {
 
 double ConfigTable::number(std::string_view key, Range range) const {
   const toml::node* n = lookup(*impl_, key);
-  if (!n) fail(key, "missing; expected " + describe_range(range));
+  if (!n) fail(key, missing_message(*impl_, key, "expected " + describe_range(range)));
   auto v = as_number(*n);
   if (!v) fail(key, std::string("expected ") + describe_range(range) + ", got " + type_name(*n));
   if (!in_range(*v, range)) {
@@ -190,7 +203,7 @@ double ConfigTable::number_or(std::string_view key, double fallback, Range range
 
 long long ConfigTable::integer(std::string_view key, Range range) const {
   const toml::node* n = lookup(*impl_, key);
-  if (!n) fail(key, "missing; expected an integer");
+  if (!n) fail(key, missing_message(*impl_, key, "expected an integer"));
   auto v = n->value_exact<int64_t>();
   if (!v) fail(key, std::string("expected an integer, got ") + type_name(*n));
   if (!in_range(static_cast<double>(*v), range)) {
@@ -219,7 +232,7 @@ bool ConfigTable::boolean_or(std::string_view key, bool fallback) const {
 
 std::string ConfigTable::string(std::string_view key) const {
   const toml::node* n = lookup(*impl_, key);
-  if (!n) fail(key, "missing; expected a string");
+  if (!n) fail(key, missing_message(*impl_, key, "expected a string"));
   auto v = n->value_exact<std::string>();
   if (!v) fail(key, std::string("expected a string, got ") + type_name(*n));
   return *v;
@@ -249,7 +262,7 @@ std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
 std::vector<double> ConfigTable::numbers(std::string_view key, std::optional<size_t> size, Range range) const {
   const toml::node* n = lookup(*impl_, key);
   std::string expected = size ? "an array of " + std::to_string(*size) + " numbers" : std::string("an array of numbers");
-  if (!n) fail(key, "missing; expected " + expected);
+  if (!n) fail(key, missing_message(*impl_, key, "expected " + expected));
   const toml::array* arr = n->as_array();
   if (!arr) fail(key, "expected " + expected + ", got " + type_name(*n));
   if (size && arr->size() != *size) {
@@ -281,7 +294,7 @@ std::vector<double> ConfigTable::numbers_or(std::string_view key, std::vector<do
 std::vector<std::vector<double>> ConfigTable::number_rows(std::string_view key, size_t row_size, Range range) const {
   const toml::node* n = lookup(*impl_, key);
   const std::string expected = "an array of [" + std::to_string(row_size) + " numbers] arrays";
-  if (!n) fail(key, "missing; expected " + expected);
+  if (!n) fail(key, missing_message(*impl_, key, "expected " + expected));
   const toml::array* arr = n->as_array();
   if (!arr) fail(key, "expected " + expected + ", got " + type_name(*n));
   std::vector<std::vector<double>> out;

@@ -27,7 +27,7 @@ fs::path library_dir() {
     std::error_code ec;
     fs::path p = dll::this_line_location(ec);
     if (ec) p = dll::program_location(ec);
-    return p.parent_path();
+    return fs::weakly_canonical(p).parent_path();
   }();
   return dir;
 }

@@ -59,10 +59,10 @@ struct SynthPreset {
   double max_occlusion = 0.8;           // largest share of the visible shape covered
 
   // Appearance.
-  cv::Vec3d gripper_hsv{18, 100, 205};
-  cv::Vec3d tissue_hsv{4, 24, 178};
-  double tissue_contrast = 0.16;        // relative spread of the background's value
-  double noise_sigma = 3.0;             // sensor noise, grey levels
+  cv::Vec3d gripper_hsv{18, 105, 205};
+  cv::Vec3d tissue_hsv{4, 16, 188};
+  double tissue_contrast = 0.12;        // relative spread of the background's value
+  double noise_sigma = 2.5;             // sensor noise, grey levels
   double blur_sigma_px = 0.7;           // in focus
   double defocus_px_per_mm = 1.5;       // extra blur per mm away from the focal plane
   double colour_jitter = 0.02;          // per-frame relative gain spread per channel

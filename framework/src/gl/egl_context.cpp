@@ -3,8 +3,9 @@
 
 #include <GL/glcorearb.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
-#include <mutex>
 #include <thread>
 #include <utility>
 

@@ -15,6 +15,7 @@
 #include <EGL/egl.h>
 
 #include <string>
+#include <vector>
 
 #include "gl/egl_display.hpp"
 

@@ -1,6 +1,7 @@
 // Finding, reading, compiling and linking shader files.
 #include "gl/shader_program.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>

@@ -14,6 +14,9 @@
 
 namespace gtrack::render {
 
+// Clip planes a projection may carry (sensors use one or two).
+inline constexpr int kMaxSensorPlanes = 8;
+
 // The region every polygon is clipped to besides the sensor's planes, in
 // homogeneous image coordinates (u*w, v*w, w): w above a tiny positive
 // limit, and u, v within a guard band of one image size around the image.
@@ -21,7 +24,8 @@ struct Frustum {
   double u_lo, u_hi, v_lo, v_hi, w_min;
   bool contains(const Eigen::Vector3d& h) const {
     const double w = h.z();
-    return w >= w_min && h.x() >= u_lo * w && h.x() <= u_hi * w && h.y() >= v_lo * w && h.y() <= v_hi * w;
+    // Non-short-circuit: almost every vertex is inside, and branches cost more than the compares.
+    return (w >= w_min) & (h.x() >= u_lo * w) & (h.x() <= u_hi * w) & (h.y() >= v_lo * w) & (h.y() <= v_hi * w);
   }
 };
 
@@ -35,7 +39,10 @@ inline double plane_value(const Eigen::Vector4d& plane, const Eigen::Vector3d& x
   return plane.head<3>().dot(x) + plane.w();
 }
 
-inline Eigen::Vector2d dehomogenise(const Eigen::Vector3d& h) { return h.head<2>() / h.z(); }
+inline Eigen::Vector2d dehomogenise(const Eigen::Vector3d& h) {
+  const double inv_w = 1.0 / h.z();
+  return {h.x() * inv_w, h.y() * inv_w};
+}
 
 // Clips one triangle against the projection's planes and `frustum`, projects
 // it and appends the result (nothing, or one polygon, or a fan split of one)

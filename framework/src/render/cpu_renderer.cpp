@@ -13,6 +13,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/renderer.hpp"
 #include "render/bit_mask.hpp"
+#include "render/clip.hpp"
 #include "render/faces.hpp"
 #include "render/model_poser.hpp"
 #include "render/span_raster.hpp"
@@ -27,7 +28,9 @@ using render::Box;
 
 // Per worker; aligned so that two workers never share a cache line.
 struct alignas(64) Scratch {
-  std::vector<Eigen::Vector3d> vertices;
+  render::ProjectedMesh mesh;
+  std::vector<int> cut;                   // faces that need clipping
+  std::vector<Eigen::Vector3d> vertices;  // model frame, only when some face needs clipping
   std::vector<ScreenPolygon> polygons;
   Projection model_projection;
   BitMask mask;
@@ -98,9 +101,21 @@ class CpuRenderer final : public Renderer {
 
  private:
   void fill(const double* h, Scratch& s, Box& box) const {
-    poser_.pose_model(h, s.vertices);
     render::ModelPoser::to_model_frame(h, projection_, s.model_projection);
-    faces_.project(s.vertices, s.model_projection, s.polygons);
+    poser_.project(h, s.model_projection, faces_.corners(), s.mesh);
+    const render::Frustum frustum = render::frustum_of(s.model_projection);
+    s.cut.clear();
+    for (const auto& f : faces_.faces()) {
+      if (faces_.inside(f, s.mesh, frustum)) {
+        render::fill_projected(&s.mesh.image[f.first_corner], f.corners, s.mask, box);
+      } else {
+        s.cut.push_back(&f - faces_.faces().data());
+      }
+    }
+    if (s.cut.empty()) return;
+    poser_.pose_model(h, s.vertices);
+    s.polygons.clear();
+    for (int f : s.cut) faces_.clip(faces_.faces()[f], s.vertices, s.model_projection, frustum, s.polygons);
     render::fill_polygons(s.polygons, s.mask, box);
   }
 

@@ -1,15 +1,14 @@
-// Faces: fan detection on the mesh and the per-hypothesis projection.
+// Faces: fan detection on the mesh, and the clipping fallback.
 #include "render/faces.hpp"
 
-#include <array>
-
 #include "render/clip.hpp"
+#include "render/span_raster.hpp"
 
 namespace gtrack::render {
 
 namespace {
 
-constexpr int kMaxCorners = 32;  // larger fans are split; any size would be correct
+constexpr int kMaxCorners = kMaxPolygonCorners;  // larger fans are split; any size would be correct
 
 bool same_vertex(const ModelVertex& p, const ModelVertex& q) {
   return p.a == q.a && p.b == q.b && p.finger == q.finger && p.link == q.link;
@@ -60,26 +59,10 @@ Faces::Faces(const ArticulatedModel& model) {
   }
 }
 
-void Faces::project(const std::vector<Eigen::Vector3d>& vertices, const Projection& projection,
-                    std::vector<ScreenPolygon>& out) const {
-  out.clear();
-  const Frustum frustum = frustum_of(projection);
-  std::array<Eigen::Vector3d, kMaxCorners> h;
-  for (const Face& f : faces_) {
-    bool inside = true;
-    for (int k = 0; k < f.corners; ++k) {
-      const Eigen::Vector3d& x = vertices[corners_[f.first_corner + k]];
-      for (const Eigen::Vector4d& pl : projection.clip_planes) inside = inside && plane_value(pl, x) >= 0;
-      h[k] = render::project(projection, x);
-      inside = inside && frustum.contains(h[k]);
-    }
-    if (inside) {
-      emit_projected(h.data(), f.corners, out);
-      continue;
-    }
-    for (int t = f.first_triangle; t < f.first_triangle + f.triangles; ++t) {
-      clip_triangle(vertices[3 * t], vertices[3 * t + 1], vertices[3 * t + 2], projection, frustum, out);
-    }
+void Faces::clip(const Face& f, const std::vector<Eigen::Vector3d>& vertices, const Projection& projection,
+                 const Frustum& frustum, std::vector<ScreenPolygon>& out) const {
+  for (int t = f.first_triangle; t < f.first_triangle + f.triangles; ++t) {
+    clip_triangle(vertices[3 * t], vertices[3 * t + 1], vertices[3 * t + 2], projection, frustum, out);
   }
 }
 

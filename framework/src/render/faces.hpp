@@ -14,6 +14,8 @@
 
 #include "gtrack/model.hpp"
 #include "gtrack/renderer.hpp"
+#include "render/clip.hpp"
+#include "render/model_poser.hpp"
 
 namespace gtrack::render {
 
@@ -22,20 +24,32 @@ class Faces {
   Faces() = default;
   explicit Faces(const ArticulatedModel& model);
 
-  int count() const { return static_cast<int>(faces_.size()); }
-
-  // Screen polygons of the posed mesh (`vertices`: 3 per triangle, in the
-  // frame `projection` takes), replacing the contents of `out`.
-  void project(const std::vector<Eigen::Vector3d>& vertices, const Projection& projection,
-               std::vector<ScreenPolygon>& out) const;
-
- private:
   struct Face {
-    int first_corner;    // into corners_
+    int first_corner;    // into corners()
     int corners;         // polygon size
     int first_triangle;  // its triangles in the mesh
     int triangles;
   };
+  const std::vector<Face>& faces() const { return faces_; }
+  // The mesh vertex of every face corner, face after face: what needs
+  // projecting (ModelPoser::project) for inside() and the fast path.
+  const std::vector<int>& corners() const { return corners_; }
+
+  // Whether no plane and no frustum side cuts the face, given corners()
+  // projected; such a face is filled straight from its projected corners.
+  bool inside(const Face& face, const ProjectedMesh& mesh, const Frustum& frustum) const {
+    bool in = true;
+    for (int c = face.first_corner; c < face.first_corner + face.corners; ++c) {
+      in &= (mesh.inside_planes[c] != 0) & frustum.contains(mesh.image[c]);
+    }
+    return in;
+  }
+  // Appends the face clipped triangle by triangle (project_and_clip's way);
+  // `vertices` are the mesh's, in the frame `projection` takes.
+  void clip(const Face& face, const std::vector<Eigen::Vector3d>& vertices, const Projection& projection,
+            const Frustum& frustum, std::vector<ScreenPolygon>& out) const;
+
+ private:
   std::vector<int> corners_;  // mesh vertex index of each polygon corner
   std::vector<Face> faces_;
 };

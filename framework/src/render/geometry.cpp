@@ -22,7 +22,6 @@ namespace render {
 namespace {
 
 // Planes (sensor + frustum) a triangle may be cut by; each adds at most one vertex.
-constexpr int kMaxSensorPlanes = 8;
 constexpr int kFrustumPlanes = 5;
 constexpr int kMaxVertices = 3 + kMaxSensorPlanes + kFrustumPlanes;
 
@@ -63,11 +62,13 @@ void emit_projected(const Eigen::Vector3d* h, int n, std::vector<ScreenPolygon>&
   constexpr int cap = static_cast<int>(std::extent_v<decltype(ScreenPolygon::v)>);
   int start = 1;
   while (start + 1 < n) {
-    ScreenPolygon& p = out.emplace_back();
+    // Built here and copied: emplace_back() would zero the whole array first.
+    ScreenPolygon p;
     p.count = 0;
     p.v[p.count++] = dehomogenise(h[0]);
     const int end = std::min(n, start + cap - 1);
     for (int i = start; i < end; ++i) p.v[p.count++] = dehomogenise(h[i]);
+    out.push_back(p);
     start = end - 1;
   }
 }

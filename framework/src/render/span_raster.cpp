@@ -10,6 +10,8 @@
 #include <bit>
 #include <cstdint>
 
+#include "render/clip.hpp"
+
 namespace gtrack::render {
 
 namespace {
@@ -18,7 +20,8 @@ using i64 = std::int64_t;
 
 constexpr int kSubBits = 8;
 constexpr i64 kSub = i64{1} << kSubBits;  // fixed-point units per pixel
-constexpr int kMaxVertices = static_cast<int>(std::extent_v<decltype(ScreenPolygon::v)>);
+constexpr int kMaxVertices = kMaxPolygonCorners;
+static_assert(std::extent_v<decltype(ScreenPolygon::v)> <= kMaxVertices);
 
 // Fixed-point vertex, shifted by half a pixel so that pixel i's centre is at kSub * i.
 struct Fx {
@@ -57,12 +60,13 @@ inline void floor_divmod(i64 m, i64 d, double inv_d, i64& q, i64& r) {
 struct EdgeWalk {
   i64 q, r, d, sq, sr;
 
-  void start(const Fx& a, const Fx& b, i64 row) {
+  // `inv` is 1 / d, computed ahead for all edges of a polygon so that the
+  // divisions overlap instead of each stalling its walk.
+  void start(const Fx& a, const Fx& b, i64 row, double inv) {
     const i64 dx = b.x - a.x, dy = b.y - a.y;
     const i64 tie = dy < 0 ? 0 : 1;  // left edges keep centres on them, right edges do not
     const i64 m = dx * (kSub * row - a.y) + dy * a.x - tie;
     d = kSub * (dy < 0 ? -dy : dy);
-    const double inv = 1.0 / static_cast<double>(d);
     floor_divmod(m, d, inv, q, r);
     floor_divmod(kSub * dx, d, inv, sq, sr);
   }
@@ -142,7 +146,13 @@ void fill_convex(const Fx* v, int n, BitMask& mask, Box& box) {
   // only bound the row range, which the exclusive last row and the edge
   // walks already do.
   Fx e[2 * kMaxVertices + 1];
+  double inv[2 * kMaxVertices];  // 1 / d of the walk along edge e[i] -> e[i + 1]
   for (int i = 0; i < n; ++i) e[i] = e[i + n] = v[i];
+  e[2 * n] = v[0];
+  for (int i = 0; i < n; ++i) {
+    const i64 dy = e[i + 1].y - e[i].y;
+    inv[i] = inv[i + n] = 1.0 / static_cast<double>(kSub * (dy < 0 ? -dy : dy) + (dy == 0));
+  }
   int r = top, l = top + n, j = j0;
   auto right_done = [&](i64 y) { return e[r + 1].y < y || e[r + 1].y == e[r].y; };
   auto left_done = [&](i64 y) { return e[l - 1].y < y || e[l - 1].y == e[l].y; };
@@ -156,8 +166,8 @@ void fill_convex(const Fx* v, int n, BitMask& mask, Box& box) {
   EdgeWalk lw, rw;
   while (right_done(kSub * j)) ++r;
   while (left_done(kSub * j)) --l;
-  rw.start(e[r], e[r + 1], j);
-  lw.start(e[l - 1], e[l], j);
+  rw.start(e[r], e[r + 1], j, inv[r]);
+  lw.start(e[l - 1], e[l], j, inv[l - 1]);
   for (;;) {
     const int band_end = static_cast<int>(std::min<i64>(floor_shift(std::min(e[r + 1].y, e[l - 1].y)), j1));
     const int rows = band_end - j + 1;
@@ -172,11 +182,11 @@ void fill_convex(const Fx* v, int n, BitMask& mask, Box& box) {
     // there; both give the same bound on that row.
     if (right_done(kSub * j)) {
       while (right_done(kSub * j)) ++r;
-      rw.start(e[r], e[r + 1], j);
+      rw.start(e[r], e[r + 1], j, inv[r]);
     }
     if (left_done(kSub * j)) {
       while (left_done(kSub * j)) --l;
-      lw.start(e[l - 1], e[l], j);
+      lw.start(e[l - 1], e[l], j, inv[l - 1]);
     }
   }
   box.y0 = std::min(box.y0, j0);
@@ -205,11 +215,8 @@ bool is_convex(const Fx* v, int n) {
   return turns <= 2;
 }
 
-void fill_polygon(const ScreenPolygon& p, BitMask& mask, Box& box) {
-  const int n = p.count;
-  if (n < 3) return;
-  Fx v[kMaxVertices + 2];
-  for (int i = 0; i < n; ++i) v[i] = {snap(p.v[i].x()) - kSub / 2, snap(p.v[i].y()) - kSub / 2};
+// `v` has room for n + 2 points.
+void fill_fixed(Fx* v, int n, BitMask& mask, Box& box) {
   v[n] = v[0];
   i64 area = 0;
   for (int i = 0; i < n; ++i) area += v[i].x * v[i + 1].y - v[i + 1].x * v[i].y;
@@ -231,10 +238,24 @@ void fill_polygon(const ScreenPolygon& p, BitMask& mask, Box& box) {
   }
 }
 
+Fx to_fixed(const Eigen::Vector2d& p) { return {snap(p.x()) - kSub / 2, snap(p.y()) - kSub / 2}; }
+
 }  // namespace
 
+void fill_projected(const Eigen::Vector3d* corners, int n, BitMask& mask, Box& box) {
+  if (n < 3 || n > kMaxVertices) return;
+  Fx v[kMaxVertices + 2];
+  for (int i = 0; i < n; ++i) v[i] = to_fixed(dehomogenise(corners[i]));
+  fill_fixed(v, n, mask, box);
+}
+
 void fill_polygons(const std::vector<ScreenPolygon>& polygons, BitMask& mask, Box& box) {
-  for (const ScreenPolygon& p : polygons) fill_polygon(p, mask, box);
+  Fx v[kMaxVertices + 2];
+  for (const ScreenPolygon& p : polygons) {
+    if (p.count < 3) continue;
+    for (int i = 0; i < p.count; ++i) v[i] = to_fixed(p.v[i]);
+    fill_fixed(v, p.count, mask, box);
+  }
 }
 
 PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const Box& box) {

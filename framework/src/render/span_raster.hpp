@@ -15,6 +15,7 @@
 // project_and_clip keeps coordinates small enough for that.
 #pragma once
 
+#include <Eigen/Core>
 #include <climits>
 #include <vector>
 
@@ -29,8 +30,16 @@ struct Box {
   bool empty() const { return y0 > y1 || w0 > w1; }
 };
 
+// Polygons passed to fill_projected may have up to this many corners.
+inline constexpr int kMaxPolygonCorners = 32;
+
 // ORs the polygons (render pixels) into `mask` and grows `box` to cover them.
 void fill_polygons(const std::vector<ScreenPolygon>& polygons, BitMask& mask, Box& box);
+
+// The same for one convex polygon given in homogeneous image coordinates,
+// inside the frustum of clip.hpp: exactly the pixels that emit_projected
+// followed by fill_polygons would give, without building ScreenPolygons.
+void fill_projected(const Eigen::Vector3d* corners, int n, BitMask& mask, Box& box);
 
 // Counts |O & P| and |P| over `box` and clears P there, so that the mask is
 // all zero again for the next hypothesis.

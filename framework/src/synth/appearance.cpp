@@ -36,7 +36,7 @@ cv::Mat make_background(std::uint64_t seed, const SynthPreset& p, cv::Size size)
   std::vector<cv::Mat> hsv(3);
   hsv[0] = cv::Mat(size, CV_32F, cv::Scalar(p.tissue_hsv[0] * 2));
   // Saturation varies little: tissue stays well below the segmentation bound.
-  hsv[1] = (p.tissue_hsv[1] + 4.0 * sat) / 255.0;
+  hsv[1] = (p.tissue_hsv[1] + 3.0 * sat) / 255.0;
   hsv[2] = (p.tissue_hsv[2] * (1.0 + p.tissue_contrast * value)) / 255.0;
   cv::max(hsv[1], 0.0, hsv[1]);
   cv::min(hsv[2], 1.0, hsv[2]);

@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include "gtrack/error.hpp"
 
@@ -197,8 +198,10 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   if (!fs::exists(p, ec)) throw InputError(spec + ": no such file or folder");
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps);
   cv::VideoCapture cap;
-  // OpenCV prints its own warnings for undecodable files; the error below says it once.
-  if (!cap.open(spec, cv::CAP_ANY) || !cap.isOpened()) {
+  // FFmpeg alone when it is there: the other backends print pages of
+  // warnings for an undecodable file, and the error below says it in a line.
+  const bool ffmpeg = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG);
+  if (!cap.open(spec, ffmpeg ? cv::CAP_FFMPEG : cv::CAP_ANY) || !cap.isOpened()) {
     throw InputError(spec + ": cannot open as a video (corrupt or unsupported format)");
   }
   return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, false);

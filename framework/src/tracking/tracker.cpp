@@ -153,8 +153,8 @@ struct Tracker::Impl {
         best = optimise(*last, stimulus_on, rng);
         e.status = TrackStatus::Tracked;
       }
-      e.terms = cost->evaluate_one(best);
       e.evaluations = cost->evaluations() - evals0;
+      e.terms = cost->evaluate_one(best);
       if (e.terms.dice > config.tracker.lost_dice) {
         ++lost;
         e.status = TrackStatus::Lost;

@@ -1,0 +1,39 @@
+// three_finger_gripper: a compiled gripper plugin from outside the gtrack tree.
+//
+// A triangular palm with one three-link finger per edge, 2 mm tip to tip.
+// Dimensions can be overridden from the [gripper] table with the keys every
+// radial gripper understands (see docs/plugins.md).
+#include <gtrack/gripper_config.hpp>
+#include <gtrack/plugin.hpp>
+
+namespace {
+
+gtrack::RadialGripperDefaults three_finger_defaults() {
+  gtrack::RadialGripperDefaults d;
+  d.spec.name = "three_finger_gripper";
+  d.spec.fingers = 3;
+  d.spec.palm_sides = 3;
+  d.spec.palm_circumradius_mm = 0.5;  // apothem 0.25 mm
+  d.widths_mm = {0.40, 0.34, 0.28, 0.0};
+  for (double len : {0.3, 0.25, 0.2}) d.spec.links.push_back({len, 0, 0});
+  d.joint_min_deg = -10;
+  d.joint_max_deg = 80;
+  d.max_adjacent_difference_deg = 45;
+  d.folded_deg = 50;
+  return d;
+}
+
+class ThreeFingerGripper final : public gtrack::Gripper {
+ public:
+  explicit ThreeFingerGripper(const gtrack::ConfigTable& t)
+      : model_(gtrack::radial_gripper_from_config(t, three_finger_defaults())) {}
+  const gtrack::ArticulatedModel& model() const override { return model_; }
+
+ private:
+  gtrack::ArticulatedModel model_;
+};
+
+}  // namespace
+
+GTRACK_PLUGIN(ThreeFingerGripper, gtrack::Gripper, "three_finger_gripper", "0.1.0",
+              "example: triangular palm, 3 fingers x 3 links, 2 mm tip to tip")

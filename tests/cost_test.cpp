@@ -1,0 +1,119 @@
+// Paper eq. (1): D from the renderer's counts, K and S from the plugins, weights.
+#include <gtest/gtest.h>
+
+#include "gtrack/cost.hpp"
+
+namespace {
+
+// A renderer that returns prepared counts, to check the arithmetic alone.
+class CountsRenderer final : public gtrack::Renderer {
+ public:
+  std::vector<gtrack::PairCounts> counts;
+  std::uint64_t observed = 0;
+  int submitted = 0;
+  std::string name() const override { return "counts"; }
+  void set_model(const gtrack::ArticulatedModel&) override {}
+  void set_projection(const gtrack::Projection&, double) override {}
+  gtrack::ImageSize render_size() const override { return {8, 8}; }
+  void set_observation(const cv::Mat&) override {}
+  std::uint64_t observation_count() const override { return observed; }
+  void submit(const Eigen::MatrixXd& h) override {
+    ++submitted;
+    n_ = static_cast<int>(h.cols());
+  }
+  void finish(std::vector<gtrack::PairCounts>& out) override { out.assign(counts.begin(), counts.begin() + n_); }
+  cv::Mat render_mask(const Eigen::VectorXd&) override { return {}; }
+
+ private:
+  int n_ = 0;
+};
+
+class FixedGripper final : public gtrack::Gripper {
+ public:
+  FixedGripper() {
+    gtrack::RadialGripperSpec s;
+    s.name = "t";
+    s.fingers = 2;
+    s.palm_sides = 4;
+    s.links = {{0.2, 0.1, 0.0}};
+    model_ = gtrack::ArticulatedModel(gtrack::make_radial_gripper(s));
+  }
+  const gtrack::ArticulatedModel& model() const override { return model_; }
+  double kinematic_penalty(std::span<const double> q) const override { return q[0] > 50 ? 0.5 : 0.0; }
+
+ private:
+  gtrack::ArticulatedModel model_;
+};
+
+class FixedStimulus final : public gtrack::Stimulus {
+ public:
+  void update(double, double) override {}
+  gtrack::StimulusState state() const override { return {}; }
+  double penalty(std::span<const double> q) const override { return q[1] < 10 ? 0.25 : 0.0; }
+  double fold_fraction() const override { return 0.5; }
+  double target_joint_deg(double c) const override { return c; }
+};
+
+TEST(Cost, DiceDistanceFromCounts) {
+  EXPECT_DOUBLE_EQ(gtrack::dice_distance(100, 100, 100), 0.0);  // identical
+  EXPECT_DOUBLE_EQ(gtrack::dice_distance(0, 100, 50), 1.0);     // disjoint
+  // |O&P| = 30, |O| = 60, |P| = 40: |O|P| = 70, D = 1 - 60/100.
+  EXPECT_DOUBLE_EQ(gtrack::dice_distance(30, 60, 40), 1.0 - 60.0 / 100.0);
+}
+
+TEST(Cost, EmptyObservationDoesNotDivideByZero) {
+  EXPECT_DOUBLE_EQ(gtrack::dice_distance(0, 0, 0), 0.0);
+  EXPECT_DOUBLE_EQ(gtrack::dice_distance(0, 0, 25), 1.0);
+  EXPECT_DOUBLE_EQ(gtrack::dice_distance(0, 25, 0), 1.0);
+}
+
+TEST(Cost, WeightedSumOfTermsInOneBatch) {
+  CountsRenderer r;
+  r.observed = 60;
+  r.counts = {{30, 40}, {60, 60}, {0, 0}};
+  FixedGripper g;
+  FixedStimulus s;
+  gtrack::CostEvaluator eval({&r}, g, &s, gtrack::CostWeights{});
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 3);
+  h(6, 0) = 60;  // K = 0.5
+  h(7, 0) = 5;   // S = 0.25
+  h(7, 1) = 20;
+  h(7, 2) = 20;
+  std::vector<gtrack::CostTerms> t;
+  eval.evaluate(h, t);
+  EXPECT_EQ(r.submitted, 1);
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_DOUBLE_EQ(t[0].dice, 0.4);
+  EXPECT_DOUBLE_EQ(t[0].kinematic, 0.5);
+  EXPECT_DOUBLE_EQ(t[0].stimulus, 0.25);
+  EXPECT_DOUBLE_EQ(t[0].total, 2.0 * 0.4 + 0.15 * 0.5 + 1.0 * 0.25);
+  EXPECT_DOUBLE_EQ(t[1].total, 0.0);
+  EXPECT_DOUBLE_EQ(t[2].dice, 1.0);
+  Eigen::VectorXd totals;
+  eval.evaluate(h, totals);
+  EXPECT_DOUBLE_EQ(totals[0], t[0].total);
+  EXPECT_EQ(eval.evaluations(), 6u);
+}
+
+TEST(Cost, NoStimulusMeansNoS) {
+  CountsRenderer r;
+  r.observed = 10;
+  r.counts = {{10, 10}};
+  FixedGripper g;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, gtrack::CostWeights{});
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(8);
+  EXPECT_DOUBLE_EQ(eval.evaluate_one(h).stimulus, 0.0);
+  EXPECT_DOUBLE_EQ(eval.evaluate_one(h).total, 0.0);
+}
+
+TEST(Cost, SeveralViewsAverageD) {
+  CountsRenderer a, b;
+  a.observed = b.observed = 10;
+  a.counts = {{10, 10}};
+  b.counts = {{0, 10}};
+  FixedGripper g;
+  gtrack::CostEvaluator eval({&a, &b}, g, nullptr, gtrack::CostWeights{});
+  EXPECT_DOUBLE_EQ(eval.evaluate_one(Eigen::VectorXd::Zero(8)).dice, 0.5);
+}
+
+}  // namespace

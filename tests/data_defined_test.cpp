@@ -1,0 +1,110 @@
+// The gripper defined only in TOML: both forms, a separate model file, errors.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "support/plugins.hpp"
+
+using gtrack::testing::make_gripper;
+
+namespace {
+
+const std::string kFourFinger = R"(plugin = "data_defined"
+name = "four_finger"
+palm_mm = [[0.4, 0.0], [0.0, 0.4], [-0.4, 0.0], [0.0, -0.4]]
+symmetry_order = 4
+[[finger]]
+base_mm = [0.2, 0.2]
+direction_deg = 45
+link_lengths_mm = [0.3, 0.3]
+link_widths_mm = [0.4, 0.3, 0.0]
+[[finger]]
+base_mm = [-0.2, 0.2]
+direction_deg = 135
+link_lengths_mm = [0.3, 0.3]
+link_widths_mm = [0.4, 0.3, 0.0]
+[[finger]]
+base_mm = [-0.2, -0.2]
+direction_deg = 225
+link_lengths_mm = [0.3, 0.3]
+link_widths_mm = [0.4, 0.3, 0.0]
+[[finger]]
+base_mm = [0.2, -0.2]
+direction_deg = 315
+link_lengths_mm = [0.3, 0.3]
+link_widths_mm = [0.4, 0.3, 0.0]
+)";
+
+TEST(DataDefinedGripper, ExplicitFingers) {
+  auto g = make_gripper(kFourFinger);
+  const auto& m = g->model();
+  EXPECT_EQ(m.fingers(), 4);
+  EXPECT_EQ(m.dims(), 10);
+  EXPECT_EQ(m.triangles(), 2 + 4 * 3);
+  EXPECT_EQ(m.geometry().collision.adjacent.size(), 4u);
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(10);
+  auto tips = m.fingertips(h);
+  const double r = std::hypot(0.2, 0.2) + 0.6;
+  EXPECT_NEAR(tips[0].x(), r * std::cos(M_PI / 4), 1e-9);
+  EXPECT_NEAR(tips[0].y(), r * std::sin(M_PI / 4), 1e-9);
+  // The symmetry is usable: a quarter turn maps fingertips onto fingertips.
+  h << 0, 0, 50, 10, 20, 30, 5, 15, 25, 35;
+  auto e = m.symmetric_equivalent(h, 1);
+  auto a = m.fingertips(h), b = m.fingertips(e);
+  for (const auto& p : a) {
+    double best = 1e9;
+    for (const auto& q : b) best = std::min(best, (p - q).norm());
+    EXPECT_LT(best, 1e-9);
+  }
+}
+
+TEST(DataDefinedGripper, RadialFormAndModelFile) {
+  auto g = make_gripper(
+      "plugin = \"data_defined\"\n[radial]\nfingers = 5\npalm_circumradius_mm = 0.5\n"
+      "link_lengths_mm = [0.2, 0.2, 0.2]\nlink_widths_mm = [0.3, 0.25, 0.2, 0]\n");
+  EXPECT_EQ(g->model().fingers(), 5);
+  EXPECT_EQ(g->model().triangles(), 3 + 5 * 5);
+
+  const auto dir = std::filesystem::temp_directory_path() / "gtrack_data_defined_test";
+  std::filesystem::create_directories(dir);
+  std::string body = kFourFinger.substr(kFourFinger.find('\n') + 1);  // without the plugin line
+  std::ofstream(dir / "four.toml") << body;
+  std::ofstream(dir / "config.toml") << "[gripper]\nplugin = \"data_defined\"\nmodel_file = \"four.toml\"\n";
+  auto root = gtrack::ConfigTable::load_file((dir / "config.toml").string());
+  auto g2 = gtrack::testing::loader().make_gripper(root.table("gripper"));
+  EXPECT_EQ(g2->model().fingers(), 4);
+}
+
+std::string config_error(const std::string& toml) {
+  try {
+    make_gripper(toml);
+  } catch (const gtrack::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(DataDefinedGripper, MistakesAreLocated) {
+  // Clockwise palm.
+  std::string clockwise = kFourFinger;
+  clockwise.replace(clockwise.find("[[0.4, 0.0], [0.0, 0.4], [-0.4, 0.0], [0.0, -0.4]]"), 50,
+                    "[[0.4, 0.0], [0.0, -0.4], [-0.4, 0.0], [0.0, 0.4]]");
+  EXPECT_NE(config_error(clockwise).find("<test>:3: key 'palm_mm'"), std::string::npos) << config_error(clockwise);
+  // Widths do not match the links.
+  std::string widths = kFourFinger;
+  widths.replace(widths.find("link_widths_mm = [0.4, 0.3, 0.0]"), 32, "link_widths_mm = [0.4, 0.3]");
+  EXPECT_NE(config_error(widths).find("finger[0].link_widths_mm"), std::string::npos) << config_error(widths);
+  // A misspelled key inside a finger.
+  std::string typo = kFourFinger;
+  typo.replace(typo.find("direction_deg = 45"), 18, "directon_deg = 45");
+  const std::string e = config_error(typo);
+  EXPECT_NE(e.find("is 'directon_deg' a misspelling of it?"), std::string::npos) << e;
+  // No fingers at all.
+  EXPECT_NE(config_error("plugin = \"data_defined\"\npalm_mm = [[1,0],[0,1],[-1,0]]\n").find("finger"),
+            std::string::npos);
+  // Adjacency naming a finger that does not exist.
+  EXPECT_NE(config_error(kFourFinger + "adjacent = [[1, 5]]\n").find("adjacent"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,140 @@
+// The evaluator: symmetry, geodesic angles, lost and out-of-view frames, recovery, CSV errors.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "gtrack/error.hpp"
+#include "gtrack/evaluation.hpp"
+#include "support/plugins.hpp"
+
+using gtrack::testing::make_gripper;
+
+namespace {
+
+Eigen::VectorXd pose(double x, double y, double z, double rx, double ry, double rz, std::vector<double> q) {
+  Eigen::VectorXd h(6 + q.size());
+  h << x, y, z, rx, ry, rz, Eigen::Map<Eigen::VectorXd>(q.data(), q.size());
+  return h;
+}
+
+gtrack::PoseRow row(int frame, const Eigen::VectorXd& h, std::string status = "ok", double in_view = 1) {
+  gtrack::PoseRow r;
+  r.frame = frame;
+  r.h = h;
+  r.status = std::move(status);
+  r.extra["in_view"] = in_view;
+  return r;
+}
+
+TEST(Evaluation, SymmetricEquivalentScoresZero) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 100, 25, -30, 40, {5, 12, 20, 28, 35, 41});
+  for (int k = 1; k < 6; ++k) {
+    // Turned by k * 60 degrees about the palm normal, fingers renumbered.
+    const Eigen::VectorXd est = m.symmetric_equivalent(truth, k);
+    ASSERT_GT((est - truth).norm(), 1.0) << "the equivalent must differ as numbers";
+    const auto e = gtrack::compare_to_truth(m, truth, est);
+    EXPECT_NEAR(e.endpoint_um, 0, 1e-6) << k;
+    EXPECT_NEAR(e.orientation_deg, 0, 1e-6) << k;
+    EXPECT_NEAR(e.joint_deg, 0, 1e-9) << k;
+    EXPECT_NEAR(e.position_um, 0, 1e-9) << k;
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(e.axis_deg[a], 0, 1e-6) << k;
+  }
+}
+
+TEST(Evaluation, ErrorsAreInMicrometresAndDegrees) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  const Eigen::VectorXd truth = pose(0, 0, 100, 0, 0, 0, {10, 10, 10, 10, 10, 10});
+  Eigen::VectorXd est = truth;
+  est[0] += 0.003;   // 3 um in x
+  est[1] -= 0.004;   // 4 um in y
+  est[2] += 0.012;   // 12 um in depth
+  est[6] += 6;       // one finger off by 6 deg
+  const auto e = gtrack::compare_to_truth(m, truth, est);
+  EXPECT_NEAR(e.inplane_um, 5, 1e-6);
+  EXPECT_NEAR(e.depth_um, 12, 1e-6);
+  EXPECT_NEAR(e.position_um, 13, 1e-6);
+  EXPECT_NEAR(e.joint_deg, 1, 1e-9);
+  EXPECT_EQ(e.symmetry_k, 0);
+  EXPECT_NEAR(e.orientation_deg, 0, 1e-9);
+}
+
+TEST(Evaluation, GeodesicAngle) {
+  EXPECT_NEAR(gtrack::geodesic_angle_deg({0, 0, 0}, {10, 0, 0}), 10, 1e-9);
+  EXPECT_NEAR(gtrack::geodesic_angle_deg({0, 0, 170}, {0, 0, -170}), 20, 1e-9);
+  // Two rotations about different axes: the angle of R_a^T R_b, not the sum of Euler differences.
+  const Eigen::Matrix3d r = gtrack::rotation_from_euler_deg(30, 0, 0).transpose() *
+                            gtrack::rotation_from_euler_deg(0, 40, 0);
+  const double expected = Eigen::AngleAxisd(r).angle() * 180 / M_PI;
+  EXPECT_NEAR(gtrack::geodesic_angle_deg({30, 0, 0}, {0, 40, 0}), expected, 1e-9);
+  EXPECT_LT(expected, 70);
+  // The same rotation written on the other Euler branch.
+  EXPECT_NEAR(gtrack::geodesic_angle_deg({20, 30, 40}, {20 + 180, 180 - 30, 40 + 180}), 0, 1e-9);
+}
+
+TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  const Eigen::VectorXd h = pose(0, 0, 100, 0, 0, 0, {0, 0, 0, 0, 0, 0});
+  Eigen::VectorXd far = h;
+  far[0] += 1.5;  // well off the gripper
+  gtrack::PoseTable truth, est;
+  truth.fingers = est.fingers = 6;
+  // Frames 0-1 tracked, 2 lost, 3 missing, 4-5 out of view, 6-7 back in view
+  // but off track, 8 on track again.
+  for (int f = 0; f < 9; ++f) truth.rows.push_back(row(f, h, "", (f == 4 || f == 5) ? 0.0 : 1.0));
+  est.rows = {row(0, h), row(1, h), row(2, h, "lost"), row(4, h, "lost"), row(5, h, "lost"),
+              row(6, far), row(7, h, "lost"), row(8, h)};
+  const auto ev = gtrack::evaluate(m, truth, est);
+  EXPECT_EQ(ev.frames, 9);
+  EXPECT_EQ(ev.out_of_view_frames, 2);
+  EXPECT_EQ(ev.in_view_frames, 7);
+  EXPECT_EQ(ev.missing_frames, 1);
+  EXPECT_EQ(ev.lost_frames, 5);           // 2, 3 (missing), 4, 5, 7
+  EXPECT_EQ(ev.lost_in_view_frames, 3);   // 2, 3, 7
+  EXPECT_EQ(ev.evaluated_frames, 4);      // 0, 1, 6, 8
+  EXPECT_EQ(ev.off_track_frames, 1);      // 6
+  ASSERT_EQ(ev.recovery.size(), 1u);
+  EXPECT_EQ(ev.recovery[0].returned_at, 6);
+  EXPECT_EQ(ev.recovery[0].frames_to_recover, 2);
+  EXPECT_TRUE(ev.recovery[0].recovered);
+  EXPECT_EQ(ev.frames_lost_after_return, 2);
+  const std::string json = gtrack::evaluation_json(ev);
+  for (const char* key : {"\"position_um\"", "\"position_inplane_um\"", "\"depth_um\"", "\"orientation_deg\"",
+                          "\"joint_deg\"", "\"endpoint_um\"", "\"lost_frames\": 5", "\"recovery\""}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key;
+  }
+}
+
+TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
+  const auto dir = std::filesystem::temp_directory_path() / "gtrack_eval_test";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "ok.csv");
+    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg,cost,status,ms\n"
+         "0,1,2,3,4,5,6,7,8,0.1,ok,3\n"
+         "1,1,2,3,4,5,6,7,8,0.9,lost,3\n";
+  }
+  const auto t = gtrack::read_pose_table(dir / "ok.csv");
+  EXPECT_EQ(t.fingers, 2);
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.rows[1].status, "lost");
+  EXPECT_DOUBLE_EQ(t.rows[0].h[7], 8);
+  EXPECT_DOUBLE_EQ(t.rows[0].extra.at("cost"), 0.1);
+  {
+    std::ofstream f(dir / "bad.csv");
+    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg\n0,1,2,3,4,5,6,7\n1,1,two,3,4,5,6,7\n";
+  }
+  try {
+    gtrack::read_pose_table(dir / "bad.csv");
+    FAIL() << "a malformed row must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.csv:3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("y_mm"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,86 @@
+// Segmentation into O on synthetic images: colour bounds, opening, downscale,
+// ROI and the temporal prior.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "gtrack/observation.hpp"
+
+namespace {
+
+cv::Mat grey_frame() { return cv::Mat(200, 200, CV_8UC3, cv::Scalar(128, 128, 128)); }
+
+TEST(Observation, HsvBoundsOpeningAndDownscale) {
+  cv::Mat img = grey_frame();
+  cv::circle(img, {60, 60}, 20, cv::Scalar(40, 40, 200), cv::FILLED);  // saturated red disc
+  img.at<cv::Vec3b>(150, 150) = cv::Vec3b(40, 40, 200);              // one-pixel speckle
+  gtrack::ObservationConfig c;
+  c.open_kernel_px = 3;
+  gtrack::Segmenter seg(c, {200, 200}, {50, 50});
+  const cv::Mat full = seg.segment(img);
+  EXPECT_EQ(full.at<uchar>(150, 150), 0);  // removed by the opening
+  EXPECT_EQ(full.at<uchar>(60, 60), 255);
+  EXPECT_NEAR(cv::countNonZero(full), CV_PI * 20 * 20, 60);
+  const auto obs = seg.observe(img);
+  EXPECT_EQ(obs.mask.size(), cv::Size(50, 50));
+  EXPECT_NEAR(static_cast<double>(obs.count), CV_PI * 5 * 5, 8);
+  EXPECT_EQ(obs.mask.at<uchar>(15, 15), 255);
+}
+
+TEST(Observation, HueBoundsSelectAColour) {
+  cv::Mat img = grey_frame();
+  cv::rectangle(img, {10, 10, 40, 40}, cv::Scalar(200, 40, 40), cv::FILLED);  // blue: H ~ 120
+  cv::rectangle(img, {100, 100, 40, 40}, cv::Scalar(40, 200, 40), cv::FILLED);  // green: H ~ 60
+  gtrack::ObservationConfig c;
+  c.hue_min = 100;
+  c.hue_max = 140;
+  c.open_kernel_px = 0;  // square corners would be rounded off
+  gtrack::Segmenter seg(c, {200, 200}, {200, 200});
+  const cv::Mat m = seg.segment(img);
+  EXPECT_EQ(cv::countNonZero(m), 40 * 40);
+  EXPECT_EQ(m.at<uchar>(20, 20), 255);
+}
+
+TEST(Observation, LuminanceForUltrasound) {
+  cv::Mat img(100, 100, CV_8UC3, cv::Scalar(30, 30, 30));
+  cv::rectangle(img, {20, 20, 10, 10}, cv::Scalar(220, 220, 220), cv::FILLED);
+  gtrack::ObservationConfig c;
+  c.color_space = "luminance";
+  c.luminance_min = 150;
+  c.open_kernel_px = 0;
+  gtrack::Segmenter seg(c, {100, 100}, {100, 100});
+  EXPECT_EQ(seg.observe(img).count, 100u);
+}
+
+TEST(Observation, RoiAndPriorDropFarPixels) {
+  cv::Mat img = grey_frame();
+  cv::circle(img, {60, 60}, 15, cv::Scalar(40, 40, 200), cv::FILLED);    // the gripper
+  cv::circle(img, {160, 160}, 15, cv::Scalar(40, 40, 200), cv::FILLED);  // a distractor
+  gtrack::ObservationConfig c;
+  c.roi_margin_px = 20;
+  c.prior_sigma_px = 8;
+  gtrack::Segmenter seg(c, {200, 200}, {100, 100});
+  const auto all = seg.observe(img);
+  gtrack::ObservationPrior prior;
+  prior.previous_mask = cv::Mat::zeros(100, 100, CV_8U);
+  cv::circle(prior.previous_mask, {30, 30}, 7, 255, cv::FILLED);  // last model, render size
+  const auto near = seg.observe(img, &prior);
+  EXPECT_GT(all.count, near.count);
+  EXPECT_EQ(near.mask.at<uchar>(80, 80), 0);
+  EXPECT_EQ(near.mask.at<uchar>(30, 30), 255);
+  EXPECT_LT(near.roi.width, 200);
+  // Without the ROI the prior alone still drops the distractor.
+  c.roi = false;
+  gtrack::Segmenter no_roi(c, {200, 200}, {100, 100});
+  const auto prior_only = no_roi.observe(img, &prior);
+  EXPECT_EQ(prior_only.mask.at<uchar>(80, 80), 0);
+  EXPECT_EQ(prior_only.count, near.count);
+  EXPECT_EQ(prior_only.detected, all.count);
+}
+
+TEST(Observation, NothingDetectedIsEmpty) {
+  gtrack::Segmenter seg(gtrack::ObservationConfig{}, {200, 200}, {50, 50});
+  EXPECT_TRUE(seg.observe(grey_frame()).empty());
+}
+
+}  // namespace

@@ -1,0 +1,140 @@
+// Synthetic sequences: the drawn gripper is the model the tracker renders,
+// segmented by the default observation settings; plans are deterministic and
+// have the occlusions, exits and folding the benchmark promises.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "gtrack/engine_config.hpp"
+#include "gtrack/observation.hpp"
+#include "gtrack/renderer.hpp"
+#include "gtrack/sequence_io.hpp"
+#include "gtrack/synth.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+gtrack::Setup microscope() {
+  return gtrack::load_setup(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml", {});
+}
+
+TEST(Synth, SegmentedFrameMatchesTheRenderedTruth) {
+  const gtrack::Setup setup = microscope();
+  gtrack::SynthOptions o;
+  o.frames = 40;
+  o.seed = 3;
+  const auto plan = gtrack::plan_sequence(setup, o);
+  const gtrack::ObservationConfig oc;  // the shipped defaults
+  auto renderer = gtrack::make_cpu_renderer({"cpu", 0.25, 1, ""});
+  renderer->set_model(setup.model());
+  renderer->set_projection(setup.sensor->projection(), 0.25);
+  const auto rs = renderer->render_size();
+  gtrack::Segmenter seg(oc, setup.sensor->image_size(), rs);
+  int checked = 0;
+  for (int i = 0; i < o.frames && checked < 6; ++i) {
+    gtrack::SynthVisibility vis;
+    const cv::Mat frame = gtrack::render_frame(setup, plan, i, &vis);
+    if (vis.occluded > 0.001 || vis.in_view < 0.999) continue;
+    ++checked;
+    const cv::Mat observed = seg.observe(frame).mask;
+    const cv::Mat truth = renderer->render_mask(plan.frames[i].truth);
+    const double inter = cv::countNonZero(observed & truth), uni = cv::countNonZero(observed | truth);
+    const double ratio = static_cast<double>(cv::countNonZero(observed)) / cv::countNonZero(truth);
+    EXPECT_GT(inter / uni, 0.93) << "frame " << i;
+    // The outline must not be biased: a bias in size is a bias in depth.
+    EXPECT_NEAR(ratio, 1.0, 0.03) << "frame " << i;
+    std::printf("frame %d IoU %.4f area ratio %.4f\n", i, inter / uni, ratio);
+    if (getenv("DUMP")) { cv::Mat d; cv::merge(std::vector<cv::Mat>{truth, observed, cv::Mat::zeros(truth.size(), CV_8U)}, d); cv::Rect bb = cv::boundingRect(truth) ; bb -= cv::Point(4,4); bb += cv::Size(8,8); bb &= cv::Rect(0,0,d.cols,d.rows); cv::Mat z; cv::resize(d(bb), z, {}, 6, 6, cv::INTER_NEAREST); cv::imwrite("/tmp/diff" + std::to_string(i) + ".png", z); cv::imwrite("/tmp/frame" + std::to_string(i) + ".png", frame); }
+  }
+  EXPECT_GE(checked, 2);
+}
+
+TEST(Synth, SameSeedSameSequence) {
+  const gtrack::Setup setup = microscope();
+  gtrack::SynthOptions o;
+  o.frames = 12;
+  o.seed = 7;
+  const auto a = gtrack::plan_sequence(setup, o), b = gtrack::plan_sequence(setup, o);
+  o.seed = 8;
+  const auto c = gtrack::plan_sequence(setup, o);
+  for (int i = 0; i < 12; ++i) {
+    EXPECT_EQ(a.frames[i].truth, b.frames[i].truth);
+    EXPECT_EQ(a.frames[i].stimulus, b.frames[i].stimulus);
+  }
+  EXPECT_NE(a.frames[5].truth, c.frames[5].truth);
+  const cv::Mat fa = gtrack::render_frame(setup, a, 9, nullptr), fb = gtrack::render_frame(setup, b, 9, nullptr);
+  EXPECT_EQ(cv::norm(fa, fb, cv::NORM_INF), 0);
+}
+
+TEST(Synth, PlanHasOcclusionsExitsTiltsAndFolding) {
+  const gtrack::Setup setup = microscope();
+  gtrack::SynthOptions o;
+  o.frames = 300;
+  const auto plan = gtrack::plan_sequence(setup, o);
+  int occluded = 0, outside = 0;
+  double max_tilt = 0, q_min = 1e9, q_max = -1e9, max_step_um = 0;
+  const double half_view = 0.5 * 1024 * setup.sensor->mm_per_pixel(), r = setup.model().radius_mm();
+  for (size_t i = 0; i < plan.frames.size(); ++i) {
+    const auto& f = plan.frames[i];
+    occluded += f.occluder.active ? 1 : 0;
+    EXPECT_LE(f.occluder.target, 0.8 + 1e-9);
+    if (std::abs(f.truth[0]) > half_view + 0.9 * r || std::abs(f.truth[1]) > half_view + 0.9 * r) ++outside;
+    max_tilt = std::max({max_tilt, std::abs(f.truth[3]), std::abs(f.truth[4])});
+    EXPECT_LT(std::abs(f.truth[3]), 90);  // the palm never faces away: no mirror ambiguity in the truth
+    EXPECT_LT(std::abs(f.truth[4]), 90);
+    for (int k = 6; k < f.truth.size(); ++k) {
+      q_min = std::min(q_min, f.truth[k]);
+      q_max = std::max(q_max, f.truth[k]);
+    }
+    if (i > 0) max_step_um = std::max(max_step_um, 1000 * (f.truth.head<3>() - plan.frames[i - 1].truth.head<3>()).norm());
+  }
+  EXPECT_NEAR(occluded / 300.0, 0.7, 0.12);
+  EXPECT_GT(outside, 5);
+  EXPECT_GT(max_tilt, 35);
+  EXPECT_LT(q_min, 3);
+  EXPECT_GT(q_max, 50);
+  EXPECT_LT(max_step_um, 500);
+}
+
+TEST(Synth, PerHingeNoiseMovesHingesButNotTheTruth) {
+  const gtrack::Setup setup = microscope();
+  gtrack::SynthOptions o;
+  o.frames = 5;
+  const auto clean = gtrack::plan_sequence(setup, o);
+  o.joint_noise_deg = 2;
+  const auto noisy = gtrack::plan_sequence(setup, o);
+  EXPECT_EQ(clean.frames[3].truth, noisy.frames[3].truth);
+  double spread = 0;
+  for (size_t k = 0; k < noisy.frames[3].hinge_deg.size(); ++k) {
+    spread += std::abs(noisy.frames[3].hinge_deg[k] - clean.frames[3].hinge_deg[k]);
+  }
+  EXPECT_GT(spread / noisy.frames[3].hinge_deg.size(), 0.5);
+}
+
+TEST(Synth, WritesAFolderThatATrackerConfigCanLoad) {
+  const gtrack::Setup setup = microscope();
+  const fs::path dir = fs::temp_directory_path() / "gtrack_synth_test";
+  fs::remove_all(dir);
+  gtrack::SynthOptions o;
+  o.frames = 3;
+  const auto s = gtrack::write_synthetic_sequence(setup, o, dir);
+  EXPECT_EQ(s.frames, 3);
+  for (const char* f : {"frames/000000.png", "frames/000002.png", "stimulus.csv", "ground_truth.csv", "sequence.toml"}) {
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  }
+  const auto truth = gtrack::read_pose_table(dir / "ground_truth.csv");
+  ASSERT_EQ(truth.rows.size(), 3u);
+  EXPECT_EQ(truth.fingers, 6);
+  EXPECT_TRUE(truth.rows[0].extra.count("visible"));
+  const gtrack::Setup seq = gtrack::load_setup(dir / "sequence.toml", {});
+  const gtrack::EngineConfig cfg = gtrack::engine_config(seq);
+  gtrack::check_root_keys(seq);
+  EXPECT_FALSE(cfg.tracker.initial_pose.has_value());
+  EXPECT_DOUBLE_EQ(cfg.tracker.fps, 30);
+  fs::remove_all(dir);
+}
+
+}  // namespace
