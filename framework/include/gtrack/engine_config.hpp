@@ -77,6 +77,7 @@ struct TrackerConfig {
   int reinit_after_lost = 3;             // lost frames before the coarse search takes over
   int coarse_rz_steps = 12;              // rz hypotheses over one symmetry period
   int coarse_candidates = 4;             // best coarse hypotheses refined by a PSO each
+  int mirror_particles = 2;              // particles started at the mirror tilt (-rx, -ry); 0 = paper's plain init
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4
 };

@@ -47,6 +47,18 @@ class CpuRenderer final : public Renderer {
   void set_model(const ArticulatedModel& model) override {
     poser_ = render::ModelPoser(model);
     faces_ = render::Faces(model);
+    // Every worker's buffers at their largest now, so that no batch
+    // allocates, even the first one a worker happens to take part in.
+    const size_t corners = faces_.corners().size(), faces = faces_.faces().size();
+    const size_t vertices = model.mesh().size(), triangles = vertices / 3;
+    for (int w = 0; w < pool_.size(); ++w) {
+      Scratch& s = scratch_[w];
+      s.mesh.image.reserve(corners);
+      s.mesh.inside_planes.reserve(corners);
+      s.cut.reserve(faces);
+      s.vertices.reserve(vertices);
+      s.polygons.reserve(2 * triangles);  // a clipped triangle splits in two at most
+    }
   }
 
   void set_projection(const Projection& projection, double scale) override {
@@ -54,7 +66,10 @@ class CpuRenderer final : public Renderer {
     const ImageSize s = projection_.size;
     observation_.resize(s.width, s.height);
     observation_count_ = 0;
-    for (int w = 0; w < pool_.size(); ++w) scratch_[w].mask.resize(s.width, s.height);
+    for (int w = 0; w < pool_.size(); ++w) {
+      scratch_[w].mask.resize(s.width, s.height);
+      scratch_[w].model_projection.clip_planes.reserve(projection_.clip_planes.size());
+    }
     has_projection_ = true;
   }
 

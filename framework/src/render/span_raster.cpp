@@ -198,13 +198,17 @@ void fill_convex(const Fx* v, int n, BitMask& mask, Box& box) {
 i64 cross(const Fx& o, const Fx& a, const Fx& b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
 
 // Convex after snapping (snapping can bend a nearly straight boundary): no
-// turn against the orientation, and y changes direction at most twice.
+// turn against the orientation and, from five corners on, y changing
+// direction at most twice (a polygon that winds twice turns one way too).
 // `v` holds n + 2 points, the first two repeated at the end.
 bool is_convex(const Fx* v, int n) {
+  bool left_turns = true;
+  for (int i = 0; i < n; ++i) left_turns &= cross(v[i], v[i + 1], v[i + 2]) >= 0;
+  if (!left_turns) return false;
+  if (n <= 4) return true;
   int turns = 0;
   i64 last_dy = 0, first_dy = 0;
   for (int i = 0; i < n; ++i) {
-    if (cross(v[i], v[i + 1], v[i + 2]) < 0) return false;
     const i64 dy = v[i + 1].y - v[i].y;
     if (dy == 0) continue;
     if (last_dy == 0) first_dy = dy;

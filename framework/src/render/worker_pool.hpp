@@ -1,11 +1,13 @@
 // A small persistent thread pool for batches of independent items.
 //
-// A PSO generation is ~32 hypotheses of a few microseconds each, so waking
-// threads must cost far less than a batch: workers spin briefly on an atomic
-// generation counter before sleeping on it, the caller takes part as worker
-// 0, and items are handed out one at a time from an atomic counter so that
-// uneven hypotheses (a folded gripper is smaller) balance themselves. Nothing
-// is allocated per batch.
+// A PSO generation is ~32 hypotheses of a few microseconds each, so handing
+// out a batch must cost far less than the batch: the caller takes part as
+// worker 0, items are claimed one at a time from one atomic word (so uneven
+// hypotheses balance themselves: a folded gripper is smaller), and idle
+// workers spin briefly before sleeping on that word. The caller waits only
+// for the items to be finished, never for a worker to check in, so a worker
+// that the OS has not scheduled yet (a busy machine) does not hold a batch
+// up: the others take its share. Nothing is allocated per batch.
 #pragma once
 
 #include <atomic>
@@ -35,17 +37,20 @@ class WorkerPool {
  private:
   using Trampoline = void (*)(void*, int, int);
   void run_erased(int items, void* ctx, Trampoline call);
+  void run_batch(int first, int items);
   void work(int worker);
-  void drain(int worker);
+  void drain(int worker, std::uint64_t generation);
 
   std::vector<std::thread> threads_;
-  // Job of the current generation; written before `generation_` is bumped.
+  // The batch: generation, item count and next unclaimed item in one word,
+  // so that a claim is one compare-and-swap that also checks the generation.
+  alignas(64) std::atomic<std::uint64_t> job_{0};
+  alignas(64) std::atomic<int> done_{0};
+  // Written by the caller before a batch is published in job_.
   void* ctx_ = nullptr;
   Trampoline call_ = nullptr;
-  int items_ = 0;
-  alignas(64) std::atomic<int> next_{0};
-  alignas(64) std::atomic<std::uint32_t> generation_{0};
-  alignas(64) std::atomic<int> busy_{0};
+  int offset_ = 0;  // item number of the batch's first item
+  std::uint64_t generation_ = 0;
   std::atomic<bool> stop_{false};
 };
 

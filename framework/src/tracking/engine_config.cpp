@@ -119,6 +119,7 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.reinit_after_lost = static_cast<int>(t.integer_or("reinit_after_lost", c.reinit_after_lost, Range::closed(1, 1e6)));
   c.coarse_rz_steps = static_cast<int>(t.integer_or("coarse_rz_steps", c.coarse_rz_steps, Range::closed(1, 360)));
   c.coarse_candidates = static_cast<int>(t.integer_or("coarse_candidates", c.coarse_candidates, Range::closed(1, 64)));
+  c.mirror_particles = static_cast<int>(t.integer_or("mirror_particles", c.mirror_particles, Range::closed(0, 1 << 16)));
   c.progress_every = static_cast<int>(t.integer_or("progress_every", c.progress_every, Range::closed(1, 1e9)));
   c.overlay = t.boolean_or("overlay", c.overlay);
   return c;

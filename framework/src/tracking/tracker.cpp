@@ -177,7 +177,17 @@ struct Tracker::Impl {
     const Eigen::VectorXd s = spread();
     Eigen::VectorXd start = from;
     config.space.clamp(start);
-    const Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, config.pso.particles, config.space, rng);
+    Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, config.pso.particles, config.space, rng);
+    // Seen along the optical axis, a flat gripper tilted by (rx, ry) and by
+    // (-rx, -ry) casts the same silhouette. The last few particles explore
+    // the mirror tilt, so a track that picked the wrong one while the
+    // gripper was flat can switch once folding tells them apart.
+    const int mirrors = std::min(config.tracker.mirror_particles, static_cast<int>(init.cols()) - 1);
+    for (int i = static_cast<int>(init.cols()) - mirrors; i < init.cols(); ++i) {
+      init(3, i) -= 2 * start[3];
+      init(4, i) -= 2 * start[4];
+      config.space.clamp(init.col(i));
+    }
     ParticleSwarm pso(config.pso, config.space);
     pso.set_randomization_spread(s);
     const PsoResult r = pso.run(

@@ -1,0 +1,242 @@
+// gtrack sweep: the paper's Fig. 6 on synthetic sequences.
+//   6a: phalanx-endpoint error against particles N x generations G;
+//   6b: joint error when every hinge deviates from its finger's value by
+//       Gaussian noise of sd sigma (the model assumes they are equal).
+// Writes fig6a.csv / fig6b.csv and plots of them drawn with OpenCV.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "command.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/plugin_loader.hpp"
+#include "gtrack/synth.hpp"
+#include "gtrack/synthetic_benchmark.hpp"
+
+namespace po = boost::program_options;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<double> parse_list(const std::string& text, const char* option) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      out.push_back(std::stod(item));
+    } catch (...) {
+      throw gtrack::cli::UsageError(std::string("--") + option + ": '" + item + "' is not a number");
+    }
+  }
+  if (out.empty()) throw gtrack::cli::UsageError(std::string("--") + option + " needs at least one value");
+  return out;
+}
+
+struct Series {
+  std::string label;
+  std::vector<double> x, y, err;
+};
+
+// A line plot with error bars: enough for Fig. 6 without a plotting library.
+void plot(const fs::path& file, const std::string& title, const std::string& xlabel, const std::string& ylabel,
+          const std::vector<Series>& series, const std::vector<double>& xticks, bool log2x) {
+  const int W = 760, H = 520, L = 80, R = 170, T = 50, B = 70;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  auto fx = [&](double x) { return log2x ? std::log2(x) : x; };
+  double x0 = 1e300, x1 = -1e300, y1 = 0;
+  for (double t : xticks) x0 = std::min(x0, fx(t)), x1 = std::max(x1, fx(t));
+  for (const auto& s : series)
+    for (size_t i = 0; i < s.y.size(); ++i) y1 = std::max(y1, s.y[i] + s.err[i]);
+  if (x1 <= x0) x1 = x0 + 1;
+  y1 = y1 > 0 ? y1 * 1.1 : 1;
+  auto px = [&](double x) { return cv::Point(static_cast<int>(L + (fx(x) - x0) / (x1 - x0) * (W - L - R)), 0); };
+  auto py = [&](double y) { return static_cast<int>(H - B - y / y1 * (H - T - B)); };
+  const cv::Scalar black(0, 0, 0), grey(210, 210, 210);
+  for (int k = 0; k <= 5; ++k) {
+    const double y = y1 * k / 5;
+    cv::line(img, {L, py(y)}, {W - R, py(y)}, grey, 1);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", y);
+    cv::putText(img, buf, {8, py(y) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black, 1, cv::LINE_AA);
+  }
+  for (double t : xticks) {
+    const int x = px(t).x;
+    cv::line(img, {x, H - B}, {x, H - B + 6}, black, 1);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", t);
+    cv::putText(img, buf, {x - 10, H - B + 24}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black, 1, cv::LINE_AA);
+  }
+  cv::rectangle(img, {L, T}, {W - R, H - B}, black, 1);
+  cv::putText(img, title, {L, 30}, cv::FONT_HERSHEY_SIMPLEX, 0.6, black, 1, cv::LINE_AA);
+  cv::putText(img, xlabel, {L + (W - L - R) / 2 - 60, H - 20}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
+  cv::putText(img, ylabel, {8, T - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
+  const cv::Scalar colours[] = {{200, 80, 30}, {40, 160, 40}, {30, 30, 220}, {160, 40, 160}, {20, 150, 200}};
+  for (size_t s = 0; s < series.size(); ++s) {
+    const cv::Scalar c = colours[s % 5];
+    cv::Point prev;
+    for (size_t i = 0; i < series[s].x.size(); ++i) {
+      const cv::Point p(px(series[s].x[i]).x, py(series[s].y[i]));
+      cv::line(img, {p.x, py(std::max(0.0, series[s].y[i] - series[s].err[i]))},
+               {p.x, py(series[s].y[i] + series[s].err[i])}, c, 1, cv::LINE_AA);
+      cv::circle(img, p, 4, c, cv::FILLED, cv::LINE_AA);
+      if (i) cv::line(img, prev, p, c, 2, cv::LINE_AA);
+      prev = p;
+    }
+    cv::line(img, {W - R + 15, T + 20 + 22 * int(s)}, {W - R + 40, T + 20 + 22 * int(s)}, c, 2, cv::LINE_AA);
+    cv::putText(img, series[s].label, {W - R + 48, T + 25 + 22 * int(s)}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1,
+                cv::LINE_AA);
+  }
+  if (!cv::imwrite(file.string(), img)) throw gtrack::InputError(file.string() + ": cannot write");
+}
+
+struct Context {
+  gtrack::cli::CommonOptions common;
+  fs::path config, out;
+  gtrack::SynthOptions synth;
+  int sequences = 1;
+};
+
+fs::path make_sequence(const Context& c, std::uint64_t seed, double noise) {
+  char name[64];
+  std::snprintf(name, sizeof name, "seq_seed%llu_noise%.2f", static_cast<unsigned long long>(seed), noise);
+  const fs::path dir = c.out / "sequences" / name;
+  if (fs::exists(dir / "ground_truth.csv") && fs::exists(dir / "sequence.toml")) return dir;  // reuse
+  gtrack::SynthOptions o = c.synth;
+  o.seed = seed;
+  o.joint_noise_deg = noise;
+  gtrack::SetupOptions so;
+  so.plugin_paths = c.common.plugin_paths;
+  gtrack::write_synthetic_sequence(gtrack::load_setup(c.config, so), o, dir);
+  return dir;
+}
+
+struct Cell {
+  double endpoint = 0, endpoint_sd = 0, inplane = 0, depth = 0, orientation = 0, joints = 0, joints_sd = 0, fps = 0;
+  int lost = 0, frames = 0;
+};
+
+Cell run_cell(const Context& c, double noise, int particles, int generations) {
+  Cell cell;
+  for (int s = 0; s < c.sequences; ++s) {
+    const fs::path dir = make_sequence(c, c.synth.seed + s, noise);
+    const gtrack::Setup setup = gtrack::load_synthetic_setup(dir, c.common.plugin_paths);
+    gtrack::EngineConfig cfg = gtrack::engine_config(setup);
+    cfg.pso.particles = particles;
+    cfg.pso.generations = generations;
+    cfg.tracker.overlay = false;
+    const auto run = gtrack::run_synthetic_benchmark(setup, cfg, dir);
+    const auto& e = run.evaluation.in_view;
+    const double w = 1.0 / c.sequences;
+    cell.endpoint += w * e.endpoint_um.mean;
+    cell.endpoint_sd += w * e.endpoint_um.std;
+    cell.inplane += w * e.position_inplane_um.mean;
+    cell.depth += w * e.depth_um.mean;
+    cell.orientation += w * e.orientation_deg.mean;
+    cell.joints += w * e.joint_deg.mean;
+    cell.joints_sd += w * e.joint_deg.std;
+    cell.fps += w * run.tracker_fps;
+    cell.lost += run.evaluation.lost_in_view_frames;
+    cell.frames += run.frames;
+  }
+  return cell;
+}
+
+void write_row(std::ofstream& csv, const std::string& head, const Cell& c) {
+  csv << head << "," << c.frames << "," << c.endpoint << "," << c.endpoint_sd << "," << c.inplane << "," << c.depth
+      << "," << c.orientation << "," << c.joints << "," << c.joints_sd << "," << c.lost << "," << c.fps << "\n";
+  csv.flush();
+}
+
+const char* kColumns =
+    "frames,endpoint_um,endpoint_um_sd,inplane_um,depth_um,orientation_deg,joint_deg,joint_deg_sd,lost_in_view,"
+    "tracker_fps";
+
+int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
+  Context c;
+  c.common = common;
+  c.out = vm["out"].as<std::string>();
+  c.synth.frames = vm["frames"].as<int>();
+  c.synth.seed = vm["seed"].as<std::uint64_t>();
+  c.synth.preset = vm["preset"].as<std::string>();
+  c.sequences = vm["sequences"].as<int>();
+  if (c.synth.frames < 2 || c.sequences < 1) throw gtrack::cli::UsageError("--frames >= 2 and --sequences >= 1");
+  c.config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
+                                : gtrack::data_dir() / "configs" / gtrack::synth_preset(c.synth.preset).config;
+  fs::create_directories(c.out);
+  const auto particles = parse_list(vm["particles"].as<std::string>(), "particles");
+  const auto generations = parse_list(vm["generations"].as<std::string>(), "generations");
+  const auto sigmas = parse_list(vm["sigmas"].as<std::string>(), "sigmas");
+  const std::string which = vm["figure"].as<std::string>();
+  if (which != "6a" && which != "6b" && which != "both") throw gtrack::cli::UsageError("--figure: 6a, 6b or both");
+
+  if (which != "6b") {
+    std::ofstream csv(c.out / "fig6a.csv");
+    csv << "particles,generations," << kColumns << "\n";
+    std::vector<Series> series;
+    for (double g : generations) {
+      Series s;
+      s.label = "G = " + std::to_string(static_cast<int>(g));
+      for (double n : particles) {
+        const Cell cell = run_cell(c, 0, static_cast<int>(n), static_cast<int>(g));
+        write_row(csv, std::to_string(int(n)) + "," + std::to_string(int(g)), cell);
+        std::printf("6a  N=%3d G=%3d  endpoints %7.1f um  in-plane %6.1f um  orientation %5.2f deg  joints %5.2f "
+                    "deg  lost %d  %.1f frames/s\n",
+                    int(n), int(g), cell.endpoint, cell.inplane, cell.orientation, cell.joints, cell.lost, cell.fps);
+        std::fflush(stdout);
+        s.x.push_back(n);
+        s.y.push_back(cell.endpoint);
+        s.err.push_back(0);
+      }
+      series.push_back(s);
+    }
+    plot(c.out / "fig6a.png", "Fig. 6a: phalanx endpoint error vs particles", "particles N", "error (um)", series,
+         particles, true);
+  }
+  if (which != "6a") {
+    const int n = vm["fig6b-particles"].as<int>(), g = vm["fig6b-generations"].as<int>();
+    std::ofstream csv(c.out / "fig6b.csv");
+    csv << "sigma_deg,particles,generations," << kColumns << "\n";
+    Series s;
+    s.label = "N=" + std::to_string(n) + " G=" + std::to_string(g);
+    for (double sigma : sigmas) {
+      const Cell cell = run_cell(c, sigma, n, g);
+      char head[64];
+      std::snprintf(head, sizeof head, "%g,%d,%d", sigma, n, g);
+      write_row(csv, head, cell);
+      std::printf("6b  sigma=%.2f deg  joints %5.2f +- %5.2f deg  endpoints %7.1f um  lost %d\n", sigma, cell.joints,
+                  cell.joints_sd, cell.endpoint, cell.lost);
+      std::fflush(stdout);
+      s.x.push_back(sigma);
+      s.y.push_back(cell.joints);
+      s.err.push_back(cell.joints_sd);
+    }
+    plot(c.out / "fig6b.png", "Fig. 6b: joint error vs per-hinge noise", "noise sigma (deg)", "joint error (deg)",
+         {s}, sigmas, false);
+  }
+  std::cout << "results: " << c.out.string() << "/fig6a.csv, fig6a.png, fig6b.csv, fig6b.png\n";
+  return 0;
+}
+
+}  // namespace
+
+GTRACK_COMMAND(
+    "sweep", "paper Fig. 6: error vs particles x generations (6a) and vs per-hinge joint noise (6b)",
+    [](po::options_description& d) {
+      d.add_options()("out,o", po::value<std::string>()->default_value("gtrack_sweep"), "folder to write")(
+          "config,c", po::value<std::string>(), "config (default: the preset's built-in config)")(
+          "preset", po::value<std::string>()->default_value("microscope"), "synthetic setup")(
+          "frames,n", po::value<int>()->default_value(60), "frames per sequence (paper: 5614 frames in all)")(
+          "sequences", po::value<int>()->default_value(1), "sequences per cell, seeds seed, seed+1, ...")(
+          "seed,s", po::value<std::uint64_t>()->default_value(1), "first seed")(
+          "particles", po::value<std::string>()->default_value("8,16,32,64"), "values of N (6a)")(
+          "generations", po::value<std::string>()->default_value("5,10,25,50"), "values of G (6a)")(
+          "sigmas", po::value<std::string>()->default_value("0,0.5,1,1.5,2"), "per-hinge noise sd, deg (6b)")(
+          "fig6b-particles", po::value<int>()->default_value(32), "N for 6b")(
+          "fig6b-generations", po::value<int>()->default_value(25), "G for 6b")(
+          "figure", po::value<std::string>()->default_value("both"), "6a, 6b or both");
+    },
+    run_sweep)
