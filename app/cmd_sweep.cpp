@@ -71,9 +71,9 @@ void plot(const fs::path& file, const std::string& title, const std::string& xla
     cv::putText(img, buf, {x - 10, H - B + 24}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black, 1, cv::LINE_AA);
   }
   cv::rectangle(img, {L, T}, {W - R, H - B}, black, 1);
-  cv::putText(img, title, {L, 30}, cv::FONT_HERSHEY_SIMPLEX, 0.6, black, 1, cv::LINE_AA);
+  cv::putText(img, title, {L + 90, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.6, black, 1, cv::LINE_AA);
   cv::putText(img, xlabel, {L + (W - L - R) / 2 - 60, H - 20}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
-  cv::putText(img, ylabel, {8, T - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
+  cv::putText(img, ylabel, {8, T - 6}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
   const cv::Scalar colours[] = {{200, 80, 30}, {40, 160, 40}, {30, 30, 220}, {160, 40, 160}, {20, 150, 200}};
   for (size_t s = 0; s < series.size(); ++s) {
     const cv::Scalar c = colours[s % 5];

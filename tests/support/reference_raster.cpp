@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 
 namespace gtrack::testing {
 
@@ -85,7 +86,7 @@ GripperGeometry hydrogel_geometry() {
   spec.name = "hydrogel_test";
   spec.fingers = 6;
   spec.palm_sides = 6;
-  spec.palm_circumradius_mm = 0.65 / std::cos(M_PI / 6);
+  spec.palm_circumradius_mm = 0.65 / std::cos(std::numbers::pi / 6);  // apothem 0.65 mm
   const double lengths[] = {0.35, 0.35, 0.35, 0.30};
   const double widths[] = {0.60, 0.55, 0.50, 0.45, 0.0};
   for (int j = 0; j < 4; ++j) spec.links.push_back({lengths[j], widths[j], widths[j + 1]});

@@ -25,12 +25,27 @@ struct CostTerms {
   double dice = 1;       // D in [0, 1]
   double kinematic = 0;  // K
   double stimulus = 0;   // S
+  double temporal = 0;   // T (0 when no prediction is set)
   double total = 0;      // E
 };
 
 // D from counts. An empty observation and an empty hypothesis agree
 // perfectly (0); an empty observation against a non-empty hypothesis is 1.
 GTRACK_API double dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered);
+
+// D with the rendered pixels outside O (P\O) weighted by outside_weight w in
+// [0, 1]: D_w = 1 - 2|O&P| / (2|O&P| + |O\P| + w|P\O|), still in [0, 1].
+// w = 1 is dice_distance. With w < 1 a hypothesis whose silhouette spills
+// over where O is missing (an occluded part) is penalised less than one that
+// leaves observed pixels uncovered.
+GTRACK_API double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
+                                         double outside_weight);
+
+// The temporal term T: mean over parameters of ((h_d - p_d) / sigma_d)^2, p
+// the prediction; rz (index 5) differences are taken the short way when
+// wrap_rz. Parameters with sigma_d <= 0 are skipped.
+GTRACK_API double temporal_distance(const Eigen::Ref<const Eigen::VectorXd>& hypothesis,
+                                    const Eigen::VectorXd& prediction, const Eigen::VectorXd& sigma, bool wrap_rz);
 
 class GTRACK_API CostEvaluator {
  public:
@@ -45,6 +60,17 @@ class GTRACK_API CostEvaluator {
   CostTerms evaluate_one(const Eigen::VectorXd& hypothesis);
 
   void set_stimulus(const Stimulus* stimulus) { stimulus_ = stimulus; }
+  // The temporal term (lambda_T * T): the predicted configuration and the
+  // per-parameter scale. An empty prediction turns the term off.
+  void set_prediction(Eigen::VectorXd prediction, Eigen::VectorXd sigma, bool wrap_rz) {
+    prediction_ = std::move(prediction);
+    sigma_ = std::move(sigma);
+    wrap_rz_ = wrap_rz;
+  }
+  void clear_prediction() { prediction_.resize(0); }
+  // Weight w of P\O in D (1 = plain D); clamped to [0, 1].
+  void set_outside_weight(double w) { outside_weight_ = w < 0 ? 0 : (w > 1 ? 1 : w); }
+  double outside_weight() const { return outside_weight_; }
   const CostWeights& weights() const { return weights_; }
   std::uint64_t evaluations() const { return evaluations_; }
 
@@ -56,6 +82,9 @@ class GTRACK_API CostEvaluator {
   std::vector<PairCounts> counts_;
   std::vector<CostTerms> scratch_;
   std::uint64_t evaluations_ = 0;
+  Eigen::VectorXd prediction_, sigma_;
+  bool wrap_rz_ = true;
+  double outside_weight_ = 1.0;
 };
 
 }  // namespace gtrack

@@ -59,6 +59,15 @@ struct CostWeights {
   double dice = 2.0;        // lambda_D
   double kinematic = 0.15;  // lambda_K
   double stimulus = 1.0;    // lambda_S
+  // lambda_T: weight of the temporal term T, the mean squared distance of a
+  // hypothesis to the constant-velocity prediction in units of
+  // [tracker] init_spread (a diagonal Mahalanobis distance). 0 = paper.
+  double temporal = 0.05;
+  // occlusion_discount in [0, 1]: when |O| falls below the area of the model
+  // rendered at the previous estimate (ratio r < 1), rendered pixels outside
+  // O are weighted w = 1 - occlusion_discount * (1 - r) in D (see cost.hpp).
+  // 0 = paper (w = 1 always).
+  double occlusion_discount = 1.0;
 };
 
 struct SearchConfig {

@@ -76,7 +76,7 @@ struct ErrorSet {
   void add(const FrameErrors& e);
   void finish();
  private:
-  std::vector<double> sq_[9];
+  std::vector<double> values_[9];
 };
 
 struct RecoveryEpisode {

@@ -69,11 +69,15 @@ struct Estimate {
   TrackStatus status = TrackStatus::Tracked;
   std::optional<double> stimulus;  // the reading used for this frame
   std::uint64_t observed_pixels = 0;  // |O|
+  double outside_weight = 1;          // weight of P\O in D this frame ([cost] occlusion_discount)
   std::uint64_t evaluations = 0;      // hypotheses scored for this frame
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
 };
 
+// One Tracker follows one sequence. It keeps the Setup's plugin instances
+// (shared pointers): process() feeds the Setup's Stimulus, so two trackers
+// running at once need a Setup each.
 class GTRACK_API Tracker {
  public:
   // Makes the renderer named by config.render.

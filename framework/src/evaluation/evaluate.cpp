@@ -43,13 +43,13 @@ double in_view_from_sensor(const ArticulatedModel& model, const Sensor& sensor, 
 void ErrorSet::add(const FrameErrors& e) {
   const double v[9] = {e.position_um, e.inplane_um,  e.depth_um,    e.orientation_deg, e.joint_deg,
                        e.endpoint_um, e.axis_deg[0], e.axis_deg[1], e.axis_deg[2]};
-  for (int i = 0; i < 9; ++i) sq_[i].push_back(v[i]);
+  for (int i = 0; i < 9; ++i) values_[i].push_back(v[i]);
 }
 
 void ErrorSet::finish() {
   ErrorStats* out[9] = {&position_um, &position_inplane_um, &depth_um,    &orientation_deg, &joint_deg,
                         &endpoint_um, &axis_deg[0],         &axis_deg[1], &axis_deg[2]};
-  for (int i = 0; i < 9; ++i) *out[i] = stats(sq_[i]);
+  for (int i = 0; i < 9; ++i) *out[i] = stats(values_[i]);
 }
 
 Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const PoseTable& estimates,

@@ -1,12 +1,13 @@
-// The `cpu` backend: poses, clips and fills every hypothesis of a batch on a
-// small thread pool, into one bit-packed mask per worker, and counts against
-// the bit-packed observation with AND + popcount.
+// The `cpu` backend: poses, projects and fills every hypothesis of a batch
+// on a small thread pool, into one bit-packed mask per worker, and counts
+// against the bit-packed observation with AND + popcount.
 //
 // The mesh is filled face by face (faces.hpp) rather than triangle by
-// triangle. Work per hypothesis is confined to the box its polygons touch: the mask is
-// cleared there while counting, so it never needs a full clear. Every buffer
-// is owned by a worker and keeps its capacity, so after the first batch
-// nothing is allocated.
+// triangle; only faces that a plane or the guard band cuts go through
+// clipping. Work per hypothesis is confined to the box its polygons touch:
+// the mask is cleared there while counting, so it never needs a full clear.
+// Every buffer belongs to one worker and is sized when the model is set, so
+// batches allocate nothing.
 #include <memory>
 #include <string>
 
@@ -62,6 +63,11 @@ class CpuRenderer final : public Renderer {
   }
 
   void set_projection(const Projection& projection, double scale) override {
+    // Checked here: nothing on the workers' path may throw.
+    if (projection.clip_planes.size() > static_cast<size_t>(render::kMaxSensorPlanes)) {
+      throw Error("cpu renderer: a projection may have at most " + std::to_string(render::kMaxSensorPlanes) +
+                  " clip planes, got " + std::to_string(projection.clip_planes.size()));
+    }
     projection_ = scaled_projection(projection, scale);
     const ImageSize s = projection_.size;
     observation_.resize(s.width, s.height);
@@ -124,7 +130,7 @@ class CpuRenderer final : public Renderer {
       if (faces_.inside(f, s.mesh, frustum)) {
         render::fill_projected(&s.mesh.image[f.first_corner], f.corners, s.mask, box);
       } else {
-        s.cut.push_back(&f - faces_.faces().data());
+        s.cut.push_back(static_cast<int>(&f - faces_.faces().data()));
       }
     }
     if (s.cut.empty()) return;

@@ -2,6 +2,7 @@
 #include <string>
 
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/renderer.hpp"
 
 namespace gtrack {
@@ -12,7 +13,17 @@ std::unique_ptr<Renderer> make_renderer(const RenderOptions& options) {
   const std::string& b = options.backend;
   if (b == "cpu") return make_cpu_renderer(options);
   if (b == "gl") return make_gl_renderer(options);
-  if (b == "auto") return hardware_gpu_available() ? make_gl_renderer(options) : make_cpu_renderer(options);
+  if (b == "auto") {
+    if (!hardware_gpu_available()) return make_cpu_renderer(options);
+    // A GPU that is there but unusable (driver, permissions) must not stop
+    // a run that asked for nothing in particular.
+    try {
+      return make_gl_renderer(options);
+    } catch (const Error& e) {
+      logger().warn("render backend auto: gl failed ({}); using cpu", e.what());
+      return make_cpu_renderer(options);
+    }
+  }
   throw Error("unknown render backend '" + b + "'; valid backends are: auto, gl, cpu");
 }
 

@@ -15,7 +15,7 @@ SynthPreset microscope() {
   p.summary = "4 mm hydrogel gripper under a 1024x1024 microscope camera, ~8 um/px, on tissue";
   p.config = "microscope_hydrogel.toml";
   // Everything else is the struct's defaults, which were chosen for this
-  // setup: the gripper's orange at S = 100 sits far enough above the default
+  // setup: the gripper's orange at S = 105 sits far enough above the default
   // segmentation bound (S >= 60) for noise and jitter, while a half-covered
   // edge pixel (gripper mixed with tissue) lands near that bound, so the
   // segmented outline is not biased outwards by anti-aliasing or blur.

@@ -1,4 +1,5 @@
 // gtrack synth as a library call: plan, draw in parallel, write the folder.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>

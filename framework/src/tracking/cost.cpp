@@ -1,6 +1,8 @@
 // Paper eq. (1) over a batch of hypotheses.
 #include "gtrack/cost.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <span>
 
 #include "gtrack/error.hpp"
@@ -12,6 +14,34 @@ double dice_distance(std::uint64_t intersection, std::uint64_t observed, std::ui
   const std::uint64_t sum = observed + rendered;
   if (sum == 0) return 0.0;
   return 1.0 - 2.0 * static_cast<double>(intersection) / static_cast<double>(sum);
+}
+
+double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
+                              double outside_weight) {
+  if (intersection > rendered) intersection = rendered;
+  const double w = outside_weight < 0 ? 0.0 : (outside_weight > 1 ? 1.0 : outside_weight);
+  const double i = static_cast<double>(intersection);
+  const double outside = static_cast<double>(rendered - intersection);  // |P\O|
+  const double denom = static_cast<double>(observed) + i + w * outside;  // 2|O&P| + |O\P| + w|P\O|
+  if (denom <= 0) return rendered == 0 ? 0.0 : 1.0;
+  const double d = 1.0 - 2.0 * i / denom;
+  return d < 0 ? 0.0 : (d > 1 ? 1.0 : d);
+}
+
+double temporal_distance(const Eigen::Ref<const Eigen::VectorXd>& hypothesis, const Eigen::VectorXd& prediction,
+                         const Eigen::VectorXd& sigma, bool wrap_rz) {
+  const Eigen::Index n = std::min({hypothesis.size(), prediction.size(), sigma.size()});
+  double sum = 0;
+  int used = 0;
+  for (Eigen::Index d = 0; d < n; ++d) {
+    if (!(sigma[d] > 0)) continue;
+    double diff = hypothesis[d] - prediction[d];
+    if (d == 5 && wrap_rz) diff = std::remainder(diff, 360.0);
+    const double z = diff / sigma[d];
+    sum += z * z;
+    ++used;
+  }
+  return used ? sum / used : 0.0;
 }
 
 CostEvaluator::CostEvaluator(std::vector<Renderer*> renderers, const Gripper& gripper, const Stimulus* stimulus,
@@ -31,6 +61,9 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
     out[i].kinematic = gripper_->kinematic_penalty(q);
     out[i].stimulus = stimulus_ ? stimulus_->penalty(q) : 0.0;
+    out[i].temporal = (prediction_.size() > 0 && weights_.temporal > 0)
+                          ? temporal_distance(hypotheses.col(i), prediction_, sigma_, wrap_rz_)
+                          : 0.0;
   }
   for (Renderer* r : renderers_) {
     r->finish(counts_);
@@ -40,13 +73,14 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     }
     const std::uint64_t observed = r->observation_count();
     for (int i = 0; i < n; ++i) {
-      out[i].dice += dice_distance(counts_[i].intersection, observed, counts_[i].rendered);
+      out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_);
     }
   }
   const double views = static_cast<double>(renderers_.size());
   for (auto& t : out) {
     t.dice /= views;
-    t.total = weights_.dice * t.dice + weights_.kinematic * t.kinematic + weights_.stimulus * t.stimulus;
+    t.total = weights_.dice * t.dice + weights_.kinematic * t.kinematic + weights_.stimulus * t.stimulus +
+              weights_.temporal * t.temporal;
   }
   evaluations_ += n;
 }

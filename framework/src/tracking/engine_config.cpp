@@ -61,6 +61,8 @@ CostWeights read_cost(const ConfigTable& t) {
   c.dice = t.number_or("lambda_dice", c.dice, Range::non_negative());
   c.kinematic = t.number_or("lambda_kinematic", c.kinematic, Range::non_negative());
   c.stimulus = t.number_or("lambda_stimulus", c.stimulus, Range::non_negative());
+  c.temporal = t.number_or("lambda_temporal", c.temporal, Range::non_negative());
+  c.occlusion_discount = t.number_or("occlusion_discount", c.occlusion_discount, Range::closed(0.0, 1.0));
   return c;
 }
 

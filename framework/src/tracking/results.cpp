@@ -60,7 +60,8 @@ void ResultWriter::write(const Estimate& e) {
   j += ",\"cost\":" + num(e.terms.total, "%.6f") + ",\"status\":\"" + to_string(e.status) + "\",\"ms\":" +
        num(e.ms, "%.3f");
   j += ",\"D\":" + num(e.terms.dice, "%.6f") + ",\"K\":" + num(e.terms.kinematic, "%.6f") +
-       ",\"S\":" + num(e.terms.stimulus, "%.6f");
+       ",\"S\":" + num(e.terms.stimulus, "%.6f") + ",\"T\":" + num(e.terms.temporal, "%.6f") +
+       ",\"outside_weight\":" + num(e.outside_weight, "%.4f");
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);

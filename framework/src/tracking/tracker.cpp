@@ -44,6 +44,7 @@ struct Tracker::Impl {
   std::unique_ptr<CostEvaluator> cost;
   Projection render_projection;
   std::optional<Eigen::VectorXd> last;
+  std::optional<Eigen::VectorXd> before_last;  // the estimate before `last`, both tracked: the velocity
   bool started = false;  // a frame has been processed since construction or reset
   int lost = 0;          // consecutive lost frames
   Observation observation;
@@ -113,20 +114,41 @@ struct Tracker::Impl {
     // whole image when there is none or it has been lost for too long.
     const cv::Mat frame = setup.sensor->rectify(input);
     const bool searching = !last || lost >= config.tracker.reinit_after_lost;
+    std::uint64_t previous_area = 0;  // |P| of the previous estimate, render pixels
     if (!searching) {
       ObservationPrior prior;
       prior.previous_mask = renderer->render_mask(*last);
       prior.margin_scale = 1.0 + lost;
+      previous_area = static_cast<std::uint64_t>(cv::countNonZero(prior.previous_mask));
       observation = segmenter->observe(frame, &prior);
     } else {
       observation = segmenter->observe(frame, nullptr);
     }
+    // Occlusion handling (docs/tracker.md, "Partial occlusion"): the
+    // constant-velocity prediction for the temporal term, and the weight of
+    // rendered pixels outside O when O is smaller than the model at the
+    // previous estimate.
+    std::optional<Eigen::VectorXd> prediction;
+    if (!searching) prediction = predict();
+    if (prediction && config.cost.temporal > 0) {
+      cost->set_prediction(*prediction, spread(), config.space.periodic.size() > 5 && config.space.periodic[5]);
+    } else {
+      cost->clear_prediction();
+    }
+    double outside_weight = 1.0;
+    if (!searching && previous_area > 0 && config.cost.occlusion_discount > 0) {
+      const double r = std::min(1.0, static_cast<double>(observation.count) / static_cast<double>(previous_area));
+      outside_weight = 1.0 - config.cost.occlusion_discount * (1.0 - r);
+    }
+    cost->set_outside_weight(outside_weight);
+    e.outside_weight = cost->outside_weight();
     e.observed_pixels = observation.count;
     e.times.segment_ms = ms_since(t0);
 
     const auto t1 = std::chrono::steady_clock::now();
     if (observation.empty()) {
       ++lost;
+      before_last.reset();
       e.status = TrackStatus::Lost;
       e.hypothesis = last ? *last : fallback_pose();
       renderer->set_observation(observation.mask);
@@ -150,7 +172,7 @@ struct Tracker::Impl {
         best = detail::coarse_search(in, config, *cost, rng).best;
         e.status = TrackStatus::Search;
       } else {
-        best = optimise(*last, stimulus_on, rng);
+        best = optimise(*last, stimulus_on, rng, prediction ? &*prediction : nullptr);
         e.status = TrackStatus::Tracked;
       }
       e.evaluations = cost->evaluations() - evals0;
@@ -159,9 +181,15 @@ struct Tracker::Impl {
         ++lost;
         e.status = TrackStatus::Lost;
         if (!last) last = best;
+        before_last.reset();
         e.hypothesis = best;
       } else {
         lost = 0;
+        if (e.status == TrackStatus::Tracked && last) {
+          before_last = last;
+        } else {
+          before_last.reset();
+        }
         last = best;
         e.hypothesis = best;
       }
@@ -172,7 +200,21 @@ struct Tracker::Impl {
     return e;
   }
 
-  Eigen::VectorXd optimise(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng) {
+  // Constant velocity: last + (last - before_last), rz the short way; the
+  // last estimate itself when there is no velocity yet.
+  Eigen::VectorXd predict() const {
+    Eigen::VectorXd p = *last;
+    if (before_last && before_last->size() == last->size()) {
+      Eigen::VectorXd v = *last - *before_last;
+      if (v.size() > 5) v[5] = std::remainder(v[5], 360.0);
+      p += v;
+    }
+    config.space.clamp(p);
+    return p;
+  }
+
+  Eigen::VectorXd optimise(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng,
+                           const Eigen::VectorXd* prediction = nullptr) {
     const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
     const Eigen::VectorXd s = spread();
     Eigen::VectorXd start = from;
@@ -188,6 +230,9 @@ struct Tracker::Impl {
       init(4, i) -= 2 * start[4];
       config.space.clamp(init.col(i));
     }
+    // Particle 1 starts at the constant-velocity prediction (particle 0 stays
+    // at the previous best, as in the paper).
+    if (prediction && config.cost.temporal > 0 && init.cols() - mirrors > 1) init.col(1) = *prediction;
     ParticleSwarm pso(config.pso, config.space);
     pso.set_randomization_spread(s);
     const PsoResult r = pso.run(
@@ -210,6 +255,7 @@ Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::o
 
 void Tracker::reset() {
   impl_->last.reset();
+  impl_->before_last.reset();
   impl_->started = false;
   impl_->lost = 0;
 }
@@ -219,6 +265,7 @@ void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
     throw Error("set_estimate: expected " + std::to_string(impl_->config.space.dims()) + " parameters");
   }
   impl_->last = hypothesis;
+  impl_->before_last.reset();
   impl_->started = true;
   impl_->lost = 0;
 }

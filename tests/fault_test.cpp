@@ -1,0 +1,403 @@
+// Faults in the middle of a run: what the user sees and what data survives.
+//
+// Each case drives `track_sequence` (the library form of `gtrack track`) or
+// the gtrack executable into one fault and checks the promise made in
+// docs/reliability.md: one line saying what went wrong, and every frame
+// finished before the fault present and well-formed in estimates.csv.
+// Runs are tiny (128x128 frames, N=8, G=2) so the whole file takes seconds.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gtrack/config.hpp"
+#include "gtrack/engine_config.hpp"
+#include "gtrack/error.hpp"
+#include "gtrack/setup.hpp"
+#include "gtrack/tracker.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kSide = 128;
+constexpr int kFrames = 8;
+
+// A 4 mm gripper about 64 px across in a 128x128 image; tiny swarm.
+const std::string kConfig = R"(
+[sensor]
+plugin = "pinhole_microscope"
+width = 128
+height = 128
+fx = 1600.0
+fy = 1600.0
+cx = 63.5
+cy = 63.5
+working_distance_mm = 100.0
+[gripper]
+plugin = "hydrogel_six_finger"
+[stimulus]
+plugin = "temperature_hysteresis"
+mode = "reversible"
+unfold_below_C = 24.0
+fold_above_C = 27.0
+[pso]
+particles = 8
+generations = 2
+[render]
+backend = "cpu"
+[tracker]
+overlay = false
+initial_pose = [0, 0, 100, 0, 0, 0, 0, 0, 0, 0, 0, 0]
+)";
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "gtrack_fault_test" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// A saturated disc that moves a little: the segmentation finds something in
+// every frame, so each frame runs the whole pipeline.
+cv::Mat frame_image(int i) {
+  cv::Mat img(kSide, kSide, CV_8UC3, cv::Scalar(40, 40, 40));
+  cv::circle(img, {60 + i % 5, 64}, 20, cv::Scalar(0, 200, 0), cv::FILLED);
+  return img;
+}
+
+fs::path write_frames(const fs::path& dir, int n) {
+  fs::create_directories(dir);
+  for (int i = 0; i < n; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    cv::imwrite((dir / name).string(), frame_image(i));
+  }
+  return dir;
+}
+
+struct TrackRun {
+  gtrack::Setup setup;
+  gtrack::EngineConfig config;
+};
+
+TrackRun make_run(const std::string& extra = "") {
+  TrackRun r{gtrack::load_setup(gtrack::ConfigTable::parse(kConfig + extra, "fault.toml"), {}), {}};
+  r.config = gtrack::engine_config(r.setup);
+  gtrack::check_root_keys(r.setup);
+  return r;
+}
+
+std::vector<std::string> read_lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+// estimates.csv: a header and then rows of exactly as many fields, the
+// frame indices increasing; returns the frame indices.
+std::vector<int> valid_rows(const fs::path& csv) {
+  const auto lines = read_lines(csv);
+  EXPECT_FALSE(lines.empty()) << csv;
+  if (lines.empty()) return {};
+  const auto fields = [](const std::string& s) { return std::count(s.begin(), s.end(), ',') + 1; };
+  const auto n = fields(lines[0]);
+  EXPECT_EQ(lines[0].rfind("frame,x_mm", 0), 0u) << lines[0];
+  std::vector<int> frames;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(fields(lines[i]), n) << "row " << i << ": " << lines[i];
+    frames.push_back(std::stoi(lines[i]));
+    if (frames.size() > 1) EXPECT_GT(frames.back(), frames[frames.size() - 2]);
+  }
+  return frames;
+}
+
+bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == std::string::npos; }
+
+struct CliRun {
+  int code;
+  std::string output;
+};
+
+CliRun gtrack_cli(const std::string& args) {
+  const std::string cmd = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (p && std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = p ? ::pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+}  // namespace
+
+// The reference: the same inputs without a fault give one row per frame.
+TEST(Fault, NoFaultTracksEveryFrame) {
+  const fs::path dir = fresh_dir("reference");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = write_frames(dir / "frames", kFrames).string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  EXPECT_EQ(s.frames, kFrames);
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), static_cast<size_t>(kFrames));
+  EXPECT_TRUE(fs::exists(o.out_dir / "summary.json"));
+}
+
+// A video cut short (a recording interrupted, a partial copy): the frames
+// that decode are tracked, the run ends normally with them.
+TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
+  const fs::path dir = fresh_dir("truncated_video");
+  const fs::path avi = dir / "clip.avi";
+  {
+    cv::VideoWriter w(avi.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, {kSide, kSide});
+    ASSERT_TRUE(w.isOpened()) << "no MJPG writer in this OpenCV build";
+    for (int i = 0; i < 20; ++i) w.write(frame_image(i));
+  }
+  fs::resize_file(avi, fs::file_size(avi) * 6 / 10);
+
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = avi.string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  const auto rows = valid_rows(o.out_dir / "estimates.csv");
+  EXPECT_GT(s.frames, 0);
+  EXPECT_LT(s.frames, 20);
+  EXPECT_EQ(rows.size(), static_cast<size_t>(s.frames));
+  EXPECT_TRUE(fs::exists(o.out_dir / "summary.json"));
+}
+
+// A folder whose image becomes unreadable part way: the run stops at that
+// frame with one line naming the file; the frames before it are in the CSV.
+TEST(Fault, CorruptImageInFolderStopsWithTheFramesBefore) {
+  const fs::path dir = fresh_dir("corrupt_image");
+  const fs::path frames = write_frames(dir / "frames", kFrames);
+  std::ofstream(frames / "000005.png", std::ios::trunc) << "not a png";
+
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = frames.string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    FAIL() << "a corrupt image must stop the run";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_TRUE(one_line(e.what())) << e.what();
+    EXPECT_NE(std::string(e.what()).find("000005.png"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), (std::vector<int>{0, 1, 2, 3, 4}));
+}
+
+// A stimulus log shorter than the video: every frame is tracked, the frames
+// past the log hold its last reading (and the tracker warns once).
+TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {
+  const fs::path dir = fresh_dir("short_stimulus");
+  const fs::path csv = dir / "stimulus.csv";
+  std::ofstream(csv) << "frame,value\n0,22.0\n1,23.0\n2,28.5\n";
+
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = write_frames(dir / "frames", kFrames).string();
+  o.stimulus_csv = csv;
+  o.out_dir = dir / "out";
+  o.progress = false;
+  std::vector<std::optional<double>> readings;
+  o.on_frame = [&](const gtrack::Estimate& e) { readings.push_back(e.stimulus); };
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  EXPECT_EQ(s.frames, kFrames);
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(readings.size(), static_cast<size_t>(kFrames));
+  for (int i = 3; i < kFrames; ++i) {
+    ASSERT_TRUE(readings[i]) << "frame " << i;
+    EXPECT_DOUBLE_EQ(*readings[i], 28.5) << "frame " << i;
+  }
+}
+
+// A stimulus log cut in the middle of a row (the logger died while writing):
+// refused before anything is written, with file and line.
+TEST(Fault, StimulusLogCutMidRowIsRefusedWithFileAndLine) {
+  const fs::path dir = fresh_dir("cut_stimulus");
+  const fs::path csv = dir / "stimulus.csv";
+  std::ofstream(csv) << "frame,value\n0,22.0\n1,23.0\n2,";
+
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = write_frames(dir / "frames", 2).string();
+  o.stimulus_csv = csv;
+  o.out_dir = dir / "out";
+  o.progress = false;
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    FAIL() << "a malformed last row must be refused";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_TRUE(one_line(e.what())) << e.what();
+    EXPECT_NE(std::string(e.what()).find("stimulus.csv:4:"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(o.out_dir / "estimates.csv"));
+}
+
+// An output folder that cannot exist (a path under a regular file, or under
+// /dev/full): refused up front, one line, nothing tracked. Root-proof,
+// unlike a chmod'ed folder.
+TEST(Fault, UnwritableOutputFolderIsRefusedUpFront) {
+  const fs::path dir = fresh_dir("unwritable");
+  std::ofstream(dir / "a_file") << "x";
+  const TrackRun r = make_run();
+  for (const fs::path out : {dir / "a_file" / "out", fs::path("/dev/full/out")}) {
+    gtrack::TrackOptions o;
+    o.input = write_frames(dir / "frames", 2).string();
+    o.out_dir = out;
+    o.progress = false;
+    int frames_run = 0;
+    o.on_frame = [&](const gtrack::Estimate&) { ++frames_run; };
+    try {
+      gtrack::track_sequence(r.setup, r.config, o);
+      FAIL() << out << " must be refused";
+    } catch (const gtrack::InputError& e) {
+      EXPECT_TRUE(one_line(e.what())) << e.what();
+      EXPECT_NE(std::string(e.what()).find(out.string()), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(frames_run, 0);
+  }
+}
+
+// The disk fills up mid-run (estimates.jsonl on /dev/full: every write fails
+// with ENOSPC): the run stops at the first frame it cannot write, with one
+// line; estimates.csv keeps the header and the rows written before.
+TEST(Fault, DiskFullMidRunStopsWithOneLine) {
+  const fs::path dir = fresh_dir("disk_full");
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "estimates.jsonl");
+
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = write_frames(dir / "frames", kFrames).string();
+  o.out_dir = out;
+  o.progress = false;
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    FAIL() << "writes to a full disk must stop the run";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_TRUE(one_line(e.what())) << e.what();
+    EXPECT_NE(std::string(e.what()).find("disk full"), std::string::npos) << e.what();
+  }
+  // The CSV row of the frame whose JSON line failed is already flushed.
+  EXPECT_LE(valid_rows(out / "estimates.csv").size(), 1u);
+}
+
+// The output folder is deleted while the run goes on (a user cleaning up):
+// the run finishes its frames and then fails writing summary.json, in one
+// line; nothing crashes.
+TEST(Fault, OutputFolderRemovedMidRunFailsAtTheSummary) {
+  const fs::path dir = fresh_dir("removed_out");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = write_frames(dir / "frames", kFrames).string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  int frames_run = 0;
+  o.on_frame = [&](const gtrack::Estimate&) {
+    if (++frames_run == 3) fs::remove_all(o.out_dir);
+  };
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    FAIL() << "the summary cannot be written into a removed folder";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_TRUE(one_line(e.what())) << e.what();
+    EXPECT_NE(std::string(e.what()).find("summary.json"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(frames_run, kFrames);
+}
+
+// A plugin whose factory throws: the executable exits non-zero with one line
+// naming the plugin and carrying the plugin's own message.
+TEST(Fault, ThrowingPluginFactoryIsOneLineFromTheExecutable) {
+  const fs::path dir = fresh_dir("throwing_plugin");
+  const fs::path cfg = dir / "throwing.toml";
+  std::ofstream(cfg) << "[sensor]\nplugin = \"fixture_throwing_factory\"\n[gripper]\nplugin = \"hydrogel_six_finger\"\n";
+  const auto r = gtrack_cli("render --plugin-path " + std::string(GTRACK_TEST_FIXTURE_DIR) + " --config " +
+                            cfg.string() + " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out " + (dir / "m.png").string());
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_NE(r.output.find("fixture_throwing_factory"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("calibration file missing"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "m.png"));
+}
+
+// NaN and infinity are valid TOML; no numeric key may accept them. Each is a
+// ConfigError naming file, line and key, raised before any frame is read.
+TEST(Fault, NonFiniteConfigValuesAreRefusedWithFileLineKey) {
+  struct Case {
+    std::string table, key, value;
+  };
+  const std::vector<Case> cases = {
+      {"sensor", "fx", "inf"},          {"sensor", "cx", "nan"},
+      {"gripper", "joint_max_deg", "inf"}, {"stimulus", "fold_above_C", "nan"},
+      {"pso", "inertia", "nan"},        {"cost", "lambda_dice", "inf"},
+      {"cost", "lambda_kinematic", "-nan"}, {"render", "scale", "nan"},
+      {"observation", "prior_sigma_px", "inf"}, {"search", "position_min_mm", "[-inf, 0.0, 90.0]"},
+      {"tracker", "initial_pose", "[0, 0, nan, 0, 0, 0, 0, 0, 0, 0, 0, 0]"},
+      {"tracker", "default_stimulus", "nan"}, {"tracker", "fps", "inf"},
+  };
+  for (const auto& c : cases) {
+    // Replace the key if the base config has it, else add it to its table.
+    std::string text = kConfig;
+    const std::string header = "[" + c.table + "]\n";
+    const std::string line = c.key + " = " + c.value + "\n";
+    const auto at = text.find(header);
+    if (at == std::string::npos) {
+      text += header + line;
+    } else {
+      const auto body = at + header.size();
+      const auto next = text.find("\n[", body);
+      const auto old = text.find("\n" + c.key + " = ", body - 1);
+      if (old != std::string::npos && (next == std::string::npos || old < next)) {
+        text.replace(old + 1, text.find('\n', old + 1) - old, line);
+      } else {
+        text.insert(body, line);
+      }
+    }
+    SCOPED_TRACE("[" + c.table + "] " + c.key + " = " + c.value);
+    try {
+      const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "nan.toml"), {});
+      (void)gtrack::engine_config(setup);
+      FAIL() << "accepted";
+    } catch (const gtrack::Error& e) {
+      const std::string m = e.what();
+      EXPECT_TRUE(one_line(m)) << m;
+      EXPECT_EQ(m.rfind("nan.toml:", 0), 0u) << m;
+      EXPECT_NE(m.find(c.key), std::string::npos) << m;
+    }
+  }
+}
+
+// A NaN or infinity in --params never reaches the renderer.
+TEST(Fault, NonFiniteParameterVectorIsOneLine) {
+  const fs::path dir = fresh_dir("nan_params");
+  const fs::path cfg = dir / "c.toml";
+  std::ofstream(cfg) << kConfig;
+  for (const char* p : {"0,0,nan,0,0,0,0,0,0,0,0,0", "0,0,100,inf,0,0,0,0,0,0,0,0", "0,0,100,0,0,0,0,0,0,0,0,-inf"}) {
+    const auto r = gtrack_cli("render --config " + cfg.string() + " --params " + p + " --out " +
+                              (dir / "m.png").string());
+    EXPECT_NE(r.code, 0) << p;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_NE(r.output.find("not a finite number"), std::string::npos) << r.output;
+  }
+}
