@@ -19,7 +19,19 @@ fi
 cmake --build "$build_dir" --parallel "$jobs"
 
 source scripts/sanitizer_env.sh
-# Tests excluded under sanitizers only because they take minutes there (the
-# normal build runs them); none is excluded for a sanitizer finding.
-exclude=${GTRACK_ASAN_EXCLUDE:-'^(Soak\.)'}
-ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" --timeout 900 -E "$exclude"
+# Tests to leave out under sanitizers, should one ever take minutes there
+# (never for a sanitizer finding). None today: the suite runs in ~75 s.
+exclude=${GTRACK_ASAN_EXCLUDE:-'^$'}
+gl_tests='^(GlRenderer|ShaderFolder)\.'
+# Everything but the OpenGL tests: ASan, UBSan and LeakSanitizer.
+# Both runs go ahead whatever the first gives, so one report shows all.
+status=0
+ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" --timeout 900 -E "$gl_tests|$exclude" || status=1
+# The OpenGL tests run on Mesa's llvmpipe, which dlclose()s its driver
+# (libgallium, LLVM) before LeakSanitizer runs at exit: the driver's
+# process-lifetime allocations then show as leaks from "<unknown module>",
+# which no suppression can name (scripts/lsan.supp covers the parts that
+# stay loaded). So leak detection only is off for them; ASan and UBSan are on.
+ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" \
+  ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" --timeout 900 -R "$gl_tests" -E "$exclude" || status=1
+exit $status

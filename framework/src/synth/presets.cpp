@@ -22,10 +22,57 @@ SynthPreset microscope() {
   return p;
 }
 
+// The metallic grippers are a quarter of the hydrogel's size or less: the
+// field of view of their configs is scaled to match (2 and 1.6 mm across), so
+// the motion, set in fractions of the view, scales with it; depth and the
+// temperature profile are their own: they fold once past 37 C and stay folded.
+SynthPreset metallic(const char* name, const char* config, const char* summary, double depth_mm) {
+  SynthPreset p;
+  p.name = name;
+  p.summary = summary;
+  p.config = config;
+  p.depth_amplitude_mm = depth_mm;
+  p.stimulus_low = 30;
+  p.stimulus_high = 40;
+  p.stimulus_period_s = 10;
+  p.gripper_hsv = {20, 90, 215};  // gold
+  return p;
+}
+
+// B-mode ultrasound: grey levels only, a bright gripper on darker speckled
+// tissue, slow in-plane motion, small tilts and an elevational drift that
+// takes parts of the gripper out of the imaged slab.
+SynthPreset ultrasound() {
+  SynthPreset p;
+  p.name = "ultrasound";
+  p.summary = "4 mm hydrogel gripper in a 1024x662 B-mode slice, 0.09 mm/px, speckled moving tissue";
+  p.config = "ultrasound_hydrogel.toml";
+  p.inplane_amplitude = 0.35;
+  p.depth_amplitude_mm = 0.25;  // elevation: out of the imaging plane
+  p.tilt_amplitude_deg = 15;
+  p.spin_deg_per_s = 15;
+  p.exits_per_minute = 0;
+  p.occluded_frames = 0.3;
+  p.max_occlusion = 0.4;
+  p.gripper_hsv = {0, 0, 235};
+  p.tissue_hsv = {0, 0, 55};
+  p.tissue_contrast = 0.3;
+  p.noise_sigma = 10;  // speckle-like grain
+  p.blur_sigma_px = 1.0;
+  p.defocus_px_per_mm = 0;
+  return p;
+}
+
 }  // namespace
 
 const std::vector<SynthPreset>& synth_presets() {
-  static const std::vector<SynthPreset> presets = {microscope()};
+  static const std::vector<SynthPreset> presets = {
+      microscope(),
+      metallic("metallic_six", "microscope_metallic_six.toml",
+               "0.9 mm six-finger metallic gripper, microscope 2 mm across (~2 um/px)", 0.1),
+      metallic("metallic_two", "microscope_metallic_two.toml",
+               "0.75 mm two-finger metallic gripper, microscope 1.6 mm across (~1.6 um/px)", 0.08),
+      ultrasound()};
   return presets;
 }
 

@@ -45,6 +45,8 @@ struct Tracker::Impl {
   Projection render_projection;
   std::optional<Eigen::VectorXd> last;
   std::optional<Eigen::VectorXd> before_last;  // the estimate before `last`, both tracked: the velocity
+  std::uint64_t reference_area = 0;  // |P| when O last covered the whole model (0 = none yet)
+  static constexpr double kCompleteRatio = 0.9;
   bool started = false;  // a frame has been processed since construction or reset
   int lost = 0;          // consecutive lost frames
   Observation observation;
@@ -137,7 +139,13 @@ struct Tracker::Impl {
     }
     double outside_weight = 1.0;
     if (!searching && previous_area > 0 && config.cost.occlusion_discount > 0) {
-      const double r = std::min(1.0, static_cast<double>(observation.count) / static_cast<double>(previous_area));
+      // The reference area is |P| at the last frame where O covered (nearly)
+      // all of the model; it is frozen while O is short, so a track that
+      // shrinks its model to the visible part does not reset the ratio.
+      const double now = static_cast<double>(observation.count) / static_cast<double>(previous_area);
+      if (now >= kCompleteRatio || reference_area == 0) reference_area = previous_area;
+      const double r =
+          std::min(1.0, static_cast<double>(observation.count) / static_cast<double>(reference_area));
       outside_weight = 1.0 - config.cost.occlusion_discount * (1.0 - r);
     }
     cost->set_outside_weight(outside_weight);
@@ -171,6 +179,7 @@ struct Tracker::Impl {
         in.joint_hi = jhi;
         best = detail::coarse_search(in, config, *cost, rng).best;
         e.status = TrackStatus::Search;
+        reference_area = 0;
       } else {
         best = optimise(*last, stimulus_on, rng, prediction ? &*prediction : nullptr);
         e.status = TrackStatus::Tracked;
@@ -256,6 +265,7 @@ Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::o
 void Tracker::reset() {
   impl_->last.reset();
   impl_->before_last.reset();
+  impl_->reference_area = 0;
   impl_->started = false;
   impl_->lost = 0;
 }

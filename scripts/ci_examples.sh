@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The plugin SDK as a lab uses it: install gtrack to a fresh prefix, build the
+# out-of-tree examples against it, list them with the installed gtrack, and
+# track short synthetic sequences with them and with the gripper defined only
+# in TOML, checking the errors against thresholds.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir=${GTRACK_BUILD_DIR:-build}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+prefix="$work/prefix"
+
+cmake --install "$build_dir" --prefix "$prefix" > "$work/install.log"
+gtrack="$prefix/bin/gtrack"
+for ex in light_stimulus three_finger_gripper; do
+  cmake -S "examples/$ex" -B "$work/$ex" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > "$work/$ex.log"
+  cmake --build "$work/$ex" >> "$work/$ex.log"
+done
+paths=(--plugin-path "$work/light_stimulus" --plugin-path "$work/three_finger_gripper")
+listing=$(env -u GTRACK_PLUGIN_PATH "$gtrack" plugins "${paths[@]}")
+echo "$listing"
+grep -q $'^stimulus\tlight_intensity\t' <<< "$listing" || { echo "ci_examples: light_intensity not listed"; exit 1; }
+grep -q $'^gripper\tthree_finger_gripper\t' <<< "$listing" || { echo "ci_examples: three_finger_gripper not listed"; exit 1; }
+
+# mean of a metric in an evaluation JSON
+mean_of() { sed -n "s/.*\"$2\": {\"mean\": \([-0-9.e+]*\).*/\1/p" "$1" | head -n1; }
+check() {  # check FILE METRIC MAX LABEL
+  local v; v=$(mean_of "$1" "$2")
+  [ -n "$v" ] || { echo "ci_examples: $4: no $2 in $1"; exit 1; }
+  if awk -v v="$v" -v m="$3" 'BEGIN { exit !(v <= m) }'; then
+    echo "ci_examples: $4: $2 mean $v <= $3"
+  else
+    echo "ci_examples: $4: $2 mean $v exceeds $3"; exit 1
+  fi
+}
+run_setup() {  # run_setup NAME CONFIG FRAMES MAX_INPLANE_UM MAX_ORIENT_DEG MAX_JOINT_DEG
+  local name=$1 config=$2 frames=$3 out="$work/$1"
+  "$gtrack" synth --config "$config" --out "$out/seq" --frames "$frames" --seed 7 "${paths[@]}" > "$out.synth.log"
+  "$gtrack" track --config "$out/seq/sequence.toml" --input "$out/seq/frames" --stimulus "$out/seq/stimulus.csv" \
+    --out "$out/track" --log-level warn "${paths[@]}" > "$out.track.log" 2>&1
+  "$gtrack" eval --truth "$out/seq/ground_truth.csv" --estimates "$out/track/estimates.csv" \
+    --json "$out/eval.json" "${paths[@]}" | tail -n 12
+  check "$out/eval.json" position_inplane_um "$4" "$name"
+  check "$out/eval.json" orientation_deg "$5" "$name"
+  check "$out/eval.json" joint_deg "$6" "$name"
+}
+
+run_setup examples examples/example_setup.toml 30 "${EXAMPLE_MAX_UM:-60}" "${EXAMPLE_MAX_DEG:-5}" "${EXAMPLE_MAX_JOINT_DEG:-5}"
+run_setup custom_gripper "$prefix/share/gtrack/configs/microscope_custom_gripper.toml" 60 40 3 3
+echo "ci_examples: passed"
