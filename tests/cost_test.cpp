@@ -116,4 +116,74 @@ TEST(Cost, SeveralViewsAverageD) {
   EXPECT_DOUBLE_EQ(eval.evaluate_one(Eigen::VectorXd::Zero(8)).dice, 0.5);
 }
 
+TEST(Cost, OutsideWeightDiscountsOnlyRenderedPixelsOutsideO) {
+  // w = 1 is the paper's D.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(30, 60, 40, 1.0), gtrack::dice_distance(30, 60, 40));
+  // A hypothesis covering all of O (|O| = 50) and 50 more rendered pixels
+  // (an occluded half): D = 1 - 100 / (100 + w 50).
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 100, 0.5), 1.0 - 100.0 / 125.0);
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 100, 0.0), 0.0);
+  // Observed pixels left uncovered are not discounted.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(25, 50, 25, 0.5), gtrack::dice_distance(25, 50, 25));
+  // Still in [0, 1], no division by zero, weight clamped.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(0, 0, 0, 0.5), 0.0);
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(0, 0, 10, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(0, 10, 10, 0.3), 1.0);
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(30, 60, 40, 7.0), gtrack::dice_distance(30, 60, 40));
+}
+
+TEST(Cost, OccludedTruePoseBeatsShrunkenModelWithOutsideWeight) {
+  // O = 50 visible pixels of a 100-pixel model: the true pose renders 100
+  // (covering O), a shrunken hypothesis renders 60 (covering 45 of O).
+  CountsRenderer r;
+  r.observed = 50;
+  r.counts = {{50, 100}, {45, 60}};
+  FixedGripper g;
+  gtrack::CostWeights w;
+  w.temporal = 0;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, w);
+  const Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  std::vector<gtrack::CostTerms> t;
+  eval.evaluate(h, t);
+  EXPECT_GT(t[0].total, t[1].total);  // the paper's D prefers shrinking
+  eval.set_outside_weight(0.5);       // |O| / reference area
+  eval.evaluate(h, t);
+  EXPECT_LT(t[0].total, t[1].total);
+}
+
+TEST(Cost, TemporalTermIsMahalanobisToThePrediction) {
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(8), sigma = Eigen::VectorXd::Ones(8);
+  sigma[2] = 0;  // skipped
+  Eigen::VectorXd h = p;
+  EXPECT_DOUBLE_EQ(gtrack::temporal_distance(h, p, sigma, true), 0.0);
+  h[0] = 2;    // (2/1)^2
+  h[2] = 100;  // skipped
+  EXPECT_DOUBLE_EQ(gtrack::temporal_distance(h, p, sigma, true), 4.0 / 7.0);
+  // rz the short way: 179 vs -179 is 2 degrees apart.
+  h.setZero();
+  p[5] = -179;
+  h[5] = 179;
+  sigma[5] = 2;
+  EXPECT_NEAR(gtrack::temporal_distance(h, p, sigma, true), 1.0 / 7.0, 1e-12);
+  EXPECT_GT(gtrack::temporal_distance(h, p, sigma, false), 1000.0 / 7.0);
+
+  // In the evaluator: lambda_T * T is added; no prediction, no term.
+  CountsRenderer r;
+  r.observed = 10;
+  r.counts = {{10, 10}};
+  FixedGripper g;
+  gtrack::CostWeights w;
+  w.temporal = 0.5;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, w);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(8);
+  x[0] = 1;
+  EXPECT_DOUBLE_EQ(eval.evaluate_one(x).total, 0.0);
+  eval.set_prediction(Eigen::VectorXd::Zero(8), Eigen::VectorXd::Ones(8), true);
+  const gtrack::CostTerms c = eval.evaluate_one(x);
+  EXPECT_DOUBLE_EQ(c.temporal, 1.0 / 8.0);
+  EXPECT_DOUBLE_EQ(c.total, 0.5 / 8.0);
+  eval.clear_prediction();
+  EXPECT_DOUBLE_EQ(eval.evaluate_one(x).total, 0.0);
+}
+
 }  // namespace

@@ -93,7 +93,8 @@ std::optional<double> StimulusLog::value_at(int frame, double time_s) const {
   const size_t i = static_cast<size_t>(it - keys_.begin());
   if (*it == k || i == 0) return values_[i];
   const double a = (k - keys_[i - 1]) / (keys_[i] - keys_[i - 1]);
-  return values_[i - 1] + a * (values_[i] - values_[i - 1]);
+  // Written as a blend, not a difference, so that huge readings cannot overflow.
+  return (1 - a) * values_[i - 1] + a * values_[i];
 }
 
 double StimulusLog::nearest(int frame, double time_s) const {
