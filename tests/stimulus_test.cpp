@@ -42,7 +42,7 @@ TEST(TemperatureHysteresis, OtherwiseHalfAndHalf) {
 
 TEST(TemperatureHysteresis, PenaltyIsTheMeanAbsoluteErrorOfInfeasibleJoints) {
   auto s = make_stimulus(kHydrogel);
-  ramp(*s, 30.0, 30.0, 3);  // hot: folded (60 +- 10)
+  ramp(*s, 30.0, 30.0, 3);  // hot from the start: folded (60 +- 10)
   std::vector<double> folded{60, 55, 65, 70, 50, 62};
   EXPECT_DOUBLE_EQ(s->penalty(folded), 0.0);
   std::vector<double> two_open{0, 30, 60, 60, 60, 60};  // 0 and 30 infeasible: MAE = (60 + 30)/2 = 45 deg
@@ -56,6 +56,18 @@ TEST(TemperatureHysteresis, PenaltyIsTheMeanAbsoluteErrorOfInfeasibleJoints) {
   ramp(*m, 25.0, 26.0, 5);
   EXPECT_DOUBLE_EQ(m->penalty(std::vector<double>{0, 10, 30, 45, 60, 65}), 0.0);
   EXPECT_GT(m->penalty(std::vector<double>{0, 10, 30, 45, 60, 95}), 0.0);
+}
+
+TEST(TemperatureHysteresis, TheMaterialGetsTimeToSettle) {
+  auto s = make_stimulus(kHydrogel);  // settle_s = 3 by default
+  ramp(*s, 22.0, 28.0, 6);            // heated through the band, 28 C reached at t = 6 s
+  const std::vector<double> lagging(6, 20.0);
+  EXPECT_DOUBLE_EQ(s->penalty(lagging), 0.0);  // just arrived: still folding
+  ramp(*s, 28.0, 28.0, 2, 7);                  // t = 9 s: 3 s above 27 C
+  EXPECT_NEAR(s->penalty(lagging), 40.0 / 60.0, 1e-12);
+  auto instant = make_stimulus("plugin = \"temperature_hysteresis\"\nsettle_s = 0");
+  ramp(*instant, 22.0, 28.0, 6);
+  EXPECT_NEAR(instant->penalty(lagging), 40.0 / 60.0, 1e-12);
 }
 
 TEST(TemperatureHysteresis, HysteresisDrivesTheSimulatedJoint) {

@@ -1,6 +1,8 @@
 // The tracker end to end on small synthetic scenes: coarse search, frame to
 // frame tracking, files written by track_sequence, interruption, bad inputs.
 #include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -127,6 +129,43 @@ TEST(Tracker, FollowsAMovingFoldingGripper) {
     EXPECT_LT(e.terms.dice, 0.12) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
   }
+}
+
+// [cost] occlusion_discount: when half of the gripper disappears behind a
+// grey occluder, rendered pixels outside O are down-weighted (w < 1) and the
+// track holds where the paper's D would shrink the model onto what is left.
+TEST(Tracker, OcclusionDiscountsRenderedPixelsOutsideO) {
+  auto setup = make_setup();
+  auto config = gtrack::engine_config(setup);
+  config.cost.occlusion_discount = 1.0;
+  config.cost.temporal = 0.05;
+  gtrack::Tracker tracker(setup, config);
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 5);
+  tracker.set_estimate(truth);
+  const auto clean = tracker.process(scene(setup, truth, 1), 0, 0.0, 22.0);
+  EXPECT_DOUBLE_EQ(clean.outside_weight, 1.0);
+  for (int i = 1; i < 4; ++i) {
+    cv::Mat img = scene(setup, truth, i + 1);
+    // Cover the half of the gripper left of its projected centre.
+    const cv::Mat mask = tracker.renderer().render_mask(truth);
+    const cv::Moments m = cv::moments(mask, true);
+    ASSERT_GT(m.m00, 0);
+    const int cx = static_cast<int>(m.m10 / m.m00 * img.cols / mask.cols);
+    img(cv::Rect(0, 0, cx, img.rows)).setTo(cv::Scalar(120, 125, 130));
+    const auto e = tracker.process(img, i, i / 30.0, 22.0);
+    EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
+    EXPECT_LT(e.outside_weight, 0.8) << "frame " << i;
+    EXPECT_GT(e.outside_weight, 0.2) << "frame " << i;
+    EXPECT_GT(e.terms.temporal, 0.0) << "frame " << i;
+    EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.1) << "frame " << i;
+  }
+  // The paper's cost: no discount.
+  config.cost.occlusion_discount = 0;
+  gtrack::Tracker paper(setup, config);
+  paper.set_estimate(truth);
+  cv::Mat img = scene(setup, truth, 9);
+  img(cv::Rect(0, 0, img.cols / 2, img.rows)).setTo(cv::Scalar(120, 125, 130));
+  EXPECT_DOUBLE_EQ(paper.process(img, 0, 0.0, 22.0).outside_weight, 1.0);
 }
 
 TEST(Tracker, NothingDetectedIsLostNotAnError) {
@@ -308,6 +347,8 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(c.cost.dice, 2.0);
   EXPECT_DOUBLE_EQ(c.cost.kinematic, 0.15);
   EXPECT_DOUBLE_EQ(c.cost.stimulus, 1.0);
+  EXPECT_DOUBLE_EQ(c.cost.temporal, 0.0);            // lambda_temporal: paper
+  EXPECT_DOUBLE_EQ(c.cost.occlusion_discount, 0.0);  // paper
   EXPECT_EQ(c.space.dims(), 12);
   EXPECT_TRUE(c.space.periodic[5]);
 }

@@ -62,12 +62,12 @@ struct CostWeights {
   // lambda_T: weight of the temporal term T, the mean squared distance of a
   // hypothesis to the constant-velocity prediction in units of
   // [tracker] init_spread (a diagonal Mahalanobis distance). 0 = paper.
-  double temporal = 0.05;
+  double temporal = 0.0;
   // occlusion_discount in [0, 1]: when |O| falls below the area of the model
   // rendered at the previous estimate (ratio r < 1), rendered pixels outside
   // O are weighted w = 1 - occlusion_discount * (1 - r) in D (see cost.hpp).
   // 0 = paper (w = 1 always).
-  double occlusion_discount = 1.0;
+  double occlusion_discount = 0.0;
 };
 
 struct SearchConfig {

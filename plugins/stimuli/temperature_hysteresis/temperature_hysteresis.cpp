@@ -13,6 +13,10 @@
 // divided by |folded - unfolded| so that it is comparable with D in [0, 1].
 // The swarm bias is the paper's: 75% of particles start with increased joints
 // when heating in the folding range, 25% when cooling in it, 50% otherwise.
+// A material does not change shape the instant the temperature crosses the
+// band: for `settle_s` seconds after it enters the folded or unfolded range,
+// the joints are still allowed anywhere between the references (0 gives the
+// instantaneous rule).
 #include <algorithm>
 #include <cmath>
 #include <gtrack/plugin.hpp>
@@ -33,6 +37,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     min_rate_ = t.number_or("trend_threshold_C_per_s", 0.005, Range::non_negative());
     smoothing_s_ = t.number_or("trend_smoothing_s", 2.0, Range::positive());
     fold_bias_ = t.number_or("fold_bias", 0.75, Range::closed(0.5, 1.0));
+    settle_s_ = t.number_or("settle_s", 3.0, Range::non_negative());
     if (mode_ == "reversible" && !(unfold_below_ < fold_above_)) {
       t.fail("fold_above_C", "must be greater than unfold_below_C");
     }
@@ -49,6 +54,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
         state_.rate += a * (raw - state_.rate);
       }
       state_.value = value;
+      now_ = time_s;
       prev_time_ = time_s;
       has_prev_ = true;
       if (mode_ == "latching" && value >= trigger_) triggered_ = true;
@@ -118,13 +124,21 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
       return;
     }
     state_.in_transition = T > unfold_below_ - tolerance_band_C() && T < fold_above_ + tolerance_band_C();
-    if (T >= fold_above_) {
+    const int region = T >= fold_above_ ? 1 : T <= unfold_below_ ? -1 : 0;
+    if (region != region_) {
+      if (region_ != 2) first_region_ = false;
+      region_ = region;
+      region_since_ = now_;
+    }
+    const bool settled = first_region_ || now_ - region_since_ >= settle_s_;
+    if (region == 1 && settled) {
       set_band(folded_);
-    } else if (T <= unfold_below_) {
+    } else if (region == -1 && settled) {
       set_band(unfolded_);
     } else {
       state_.feasible_min_deg = lo;
       state_.feasible_max_deg = hi;
+      if (region != 0) state_.in_transition = true;
     }
   }
 
@@ -141,7 +155,10 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
   double unfold_below_, fold_above_, trigger_, unfolded_, folded_, tolerance_, min_rate_, smoothing_s_, fold_bias_;
   gtrack::StimulusState state_;
   double low_ref_ = 0, high_ref_ = 0;
-  double prev_time_ = 0;
+  double settle_s_ = 3.0;
+  double prev_time_ = 0, now_ = 0, region_since_ = 0;
+  int region_ = 2;            // none yet
+  bool first_region_ = true;  // a sequence that starts hot or cold starts settled
   bool has_prev_ = false;
   bool triggered_ = false;
 };
