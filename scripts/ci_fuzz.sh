@@ -10,18 +10,7 @@ cd "$(dirname "$0")/.."
 
 # clang and its runtime (libclang_rt.fuzzer*) are not in bootstrap.sh's list:
 # only this step needs them. Installed only if missing.
-packages=(clang libclang-rt-14-dev)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  sudo_cmd=()
-  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-  echo "ci_fuzz: installing ${missing[*]}"
-  "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+scripts/apt_install.sh clang libclang-rt-14-dev
 
 build_dir=${GTRACK_FUZZ_DIR:-build-fuzz}
 seconds=${FUZZ_SECONDS:-45}

@@ -23,15 +23,7 @@ gtrack::RadialGripperDefaults three_finger_defaults() {
   return d;
 }
 
-class ThreeFingerGripper final : public gtrack::Gripper {
- public:
-  explicit ThreeFingerGripper(const gtrack::ConfigTable& t)
-      : model_(gtrack::radial_gripper_from_config(t, three_finger_defaults())) {}
-  const gtrack::ArticulatedModel& model() const override { return model_; }
-
- private:
-  gtrack::ArticulatedModel model_;
-};
+using ThreeFingerGripper = gtrack::RadialGripper<three_finger_defaults>;
 
 }  // namespace
 

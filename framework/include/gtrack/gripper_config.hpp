@@ -10,6 +10,7 @@
 
 #include "gtrack/config.hpp"
 #include "gtrack/export.hpp"
+#include "gtrack/gripper.hpp"
 #include "gtrack/model.hpp"
 
 namespace gtrack {
@@ -26,5 +27,20 @@ struct RadialGripperDefaults {
 };
 
 GTRACK_API GripperGeometry radial_gripper_from_config(const ConfigTable& table, RadialGripperDefaults defaults);
+
+// A radial gripper plugin is its defaults: RadialGripper<my_defaults> reads
+// the keys above over them.
+//     gtrack::RadialGripperDefaults my_defaults() { ... }
+//     using MyGripper = gtrack::RadialGripper<my_defaults>;
+//     GTRACK_PLUGIN(MyGripper, gtrack::Gripper, "my_gripper", "1.0.0", "...")
+template <RadialGripperDefaults (*Defaults)()>
+class RadialGripper final : public Gripper {
+ public:
+  explicit RadialGripper(const ConfigTable& table) : model_(radial_gripper_from_config(table, Defaults())) {}
+  const ArticulatedModel& model() const override { return model_; }
+
+ private:
+  ArticulatedModel model_;
+};
 
 }  // namespace gtrack

@@ -25,15 +25,7 @@ gtrack::RadialGripperDefaults hydrogel_defaults() {
   return d;
 }
 
-class HydrogelSixFinger final : public gtrack::Gripper {
- public:
-  explicit HydrogelSixFinger(const gtrack::ConfigTable& t)
-      : model_(gtrack::radial_gripper_from_config(t, hydrogel_defaults())) {}
-  const gtrack::ArticulatedModel& model() const override { return model_; }
-
- private:
-  gtrack::ArticulatedModel model_;
-};
+using HydrogelSixFinger = gtrack::RadialGripper<hydrogel_defaults>;
 
 }  // namespace
 

@@ -26,15 +26,7 @@ gtrack::RadialGripperDefaults metallic_six_defaults() {
   return d;
 }
 
-class MetallicSixFinger final : public gtrack::Gripper {
- public:
-  explicit MetallicSixFinger(const gtrack::ConfigTable& t)
-      : model_(gtrack::radial_gripper_from_config(t, metallic_six_defaults())) {}
-  const gtrack::ArticulatedModel& model() const override { return model_; }
-
- private:
-  gtrack::ArticulatedModel model_;
-};
+using MetallicSixFinger = gtrack::RadialGripper<metallic_six_defaults>;
 
 }  // namespace
 

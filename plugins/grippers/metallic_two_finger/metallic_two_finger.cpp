@@ -24,15 +24,7 @@ gtrack::RadialGripperDefaults metallic_two_defaults() {
   return d;
 }
 
-class MetallicTwoFinger final : public gtrack::Gripper {
- public:
-  explicit MetallicTwoFinger(const gtrack::ConfigTable& t)
-      : model_(gtrack::radial_gripper_from_config(t, metallic_two_defaults())) {}
-  const gtrack::ArticulatedModel& model() const override { return model_; }
-
- private:
-  gtrack::ArticulatedModel model_;
-};
+using MetallicTwoFinger = gtrack::RadialGripper<metallic_two_defaults>;
 
 }  // namespace
 
