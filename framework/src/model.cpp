@@ -230,6 +230,13 @@ double ArticulatedModel::radius_mm() const {
   return r;
 }
 
+std::vector<std::pair<int, int>> ring_adjacency(int fingers) {
+  if (fingers < 3) return fingers == 2 ? std::vector<std::pair<int, int>>{{0, 1}} : std::vector<std::pair<int, int>>{};
+  std::vector<std::pair<int, int>> pairs;
+  for (int f = 0; f < fingers; ++f) pairs.emplace_back(f, (f + 1) % fingers);
+  return pairs;
+}
+
 GripperGeometry make_radial_gripper(const RadialGripperSpec& s) {
   if (s.palm_sides < 3 || s.fingers < 1 || s.palm_sides % s.fingers != 0) {
     throw Error("gripper '" + s.name + "': palm_sides must be >= 3 and a multiple of the number of fingers");
@@ -252,11 +259,7 @@ GripperGeometry make_radial_gripper(const RadialGripperSpec& s) {
     F.links = s.links;
     g.fingers.push_back(F);
   }
-  for (int f = 0; f < s.fingers && s.fingers > 1; ++f) {
-    const int n = (f + 1) % s.fingers;
-    if (s.fingers == 2 && f == 1) break;
-    g.collision.adjacent.emplace_back(f, n);
-  }
+  g.collision.adjacent = ring_adjacency(s.fingers);
   g.symmetry_order = s.fingers;
   return g;
 }

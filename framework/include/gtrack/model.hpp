@@ -109,6 +109,9 @@ class GTRACK_API ArticulatedModel {
   std::vector<int> finger_shift_;  // finger permutation for one symmetry step
 };
 
+// Each finger with the next, around the palm (one pair for two fingers).
+GTRACK_API std::vector<std::pair<int, int>> ring_adjacency(int fingers);
+
 // R = Rz(rz) * Ry(ry) * Rx(rx), angles in degrees.
 GTRACK_API Eigen::Matrix3d rotation_from_euler_deg(double rx, double ry, double rz);
 // Inverse of the above (rx, ry, rz in degrees).

@@ -70,11 +70,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
       f.check_all_used();
       g.fingers.push_back(F);
     }
-    const int n = static_cast<int>(g.fingers.size());
-    for (int i = 0; i < n && n > 1; ++i) {
-      if (n == 2 && i == 1) break;
-      g.collision.adjacent.emplace_back(i, (i + 1) % n);
-    }
+    g.collision.adjacent = gtrack::ring_adjacency(static_cast<int>(g.fingers.size()));
   }
   g.name = name;
   if (t.has("adjacent")) {

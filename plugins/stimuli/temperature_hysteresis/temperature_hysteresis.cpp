@@ -23,6 +23,9 @@
 
 namespace {
 
+// The folding range is entered slightly before its nominal edges.
+constexpr double kBandMarginC = 0.5;
+
 class TemperatureHysteresis final : public gtrack::Stimulus {
  public:
   explicit TemperatureHysteresis(const gtrack::ConfigTable& t) {
@@ -123,7 +126,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
       }
       return;
     }
-    state_.in_transition = T > unfold_below_ - tolerance_band_C() && T < fold_above_ + tolerance_band_C();
+    state_.in_transition = T > unfold_below_ - kBandMarginC && T < fold_above_ + kBandMarginC;
     const int region = T >= fold_above_ ? 1 : T <= unfold_below_ ? -1 : 0;
     if (region != region_) {
       if (region_ != 2) first_region_ = false;
@@ -141,9 +144,6 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
       if (region != 0) state_.in_transition = true;
     }
   }
-
-  // The folding range is entered slightly before its nominal edges.
-  double tolerance_band_C() const { return 0.5; }
 
   void set_band(double ref) {
     state_.feasible_min_deg = ref - tolerance_;
