@@ -151,6 +151,43 @@ TEST(Cost, OccludedTruePoseBeatsShrunkenModelWithOutsideWeight) {
   EXPECT_LT(t[0].total, t[1].total);
 }
 
+TEST(Cost, OutsideAllowanceTakesTheMissingAreaAsHidden) {
+  // O = 50 visible pixels of a 100-pixel model. With the 50 missing pixels
+  // allowed, the true pose (covering O, 100 rendered) scores 0, as it would
+  // unoccluded.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50), 0.0);
+  // A shrunken hypothesis (60 rendered, 45 of them on O) gains nothing from
+  // the allowance: it still leaves 5 observed pixels uncovered.
+  const double shrunk = gtrack::weighted_dice_distance(45, 50, 60, 1.0, 50);
+  EXPECT_DOUBLE_EQ(shrunk, 1.0 - 90.0 / 95.0);
+  EXPECT_GT(shrunk, 0.0);
+  // Growing beyond the allowance pays for the excess only: 130 outside, 80 counted.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 180, 1.0, 50), 1.0 - 100.0 / 180.0);
+  // The tolerance widens the allowance; the weight applies to the excess.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 110, 1.0, 50, 10), 0.0);
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 180, 0.5, 50), 1.0 - 100.0 / 140.0);
+  // No allowance: the paper's D.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(45, 50, 60, 1.0, 0), gtrack::dice_distance(45, 50, 60));
+}
+
+TEST(Cost, OccludedTruePoseBeatsShrunkenModelWithOutsideAllowance) {
+  CountsRenderer r;
+  r.observed = 50;
+  r.counts = {{50, 100}, {45, 60}};
+  FixedGripper g;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, gtrack::CostWeights{});
+  const Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  std::vector<gtrack::CostTerms> t;
+  eval.evaluate(h, t);
+  EXPECT_GT(t[0].total, t[1].total);  // the paper's D prefers shrinking
+  eval.set_outside_allowance(50);
+  EXPECT_DOUBLE_EQ(eval.outside_allowance(), 50.0);
+  eval.evaluate(h, t);
+  EXPECT_LT(t[0].total, t[1].total);
+  eval.set_outside_allowance(-3);  // clamped
+  EXPECT_DOUBLE_EQ(eval.outside_allowance(), 0.0);
+}
+
 TEST(Cost, TemporalTermIsMahalanobisToThePrediction) {
   Eigen::VectorXd p = Eigen::VectorXd::Zero(8), sigma = Eigen::VectorXd::Ones(8);
   sigma[2] = 0;  // skipped

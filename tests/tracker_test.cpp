@@ -125,7 +125,9 @@ TEST(Tracker, FollowsAMovingFoldingGripper) {
     const Eigen::VectorXd truth = pose(0.3 + 0.03 * i, -0.2, 20 + i, 5 + 2 * i);
     const auto e = tracker.process(scene(setup, truth, i + 1), i, i / 30.0, 22.0 + i);
     EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
-    EXPECT_EQ(e.evaluations, 32u * 25u);
+    // N x G per tracked frame, more only when the coarse search also ran.
+    if (e.terms.dice <= config.tracker.redetect_dice) EXPECT_EQ(e.evaluations, 32u * 25u);
+    EXPECT_GE(e.evaluations, 32u * 25u);
     EXPECT_LT(e.terms.dice, 0.12) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
   }
@@ -138,6 +140,7 @@ TEST(Tracker, OcclusionDiscountsRenderedPixelsOutsideO) {
   auto setup = make_setup();
   auto config = gtrack::engine_config(setup);
   config.cost.occlusion_discount = 1.0;
+  config.cost.occlusion_budget = 0;  // the discount on its own
   config.cost.temporal = 0.05;
   gtrack::Tracker tracker(setup, config);
   const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 5);
@@ -336,6 +339,78 @@ TEST(TrackSequence, BadInputsAreInputErrors) {
   EXPECT_THROW(gtrack::track_sequence(setup, config, opt), gtrack::InputError);
 }
 
+// A half-covered gripper image, the left half of its projected centre hidden
+// behind background grey.
+cv::Mat half_covered(gtrack::Tracker& tracker, const gtrack::Setup& setup, const Eigen::VectorXd& truth,
+                     std::uint64_t seed) {
+  cv::Mat img = scene(setup, truth, seed);
+  const cv::Mat mask = tracker.renderer().render_mask(truth);
+  const cv::Moments m = cv::moments(mask, true);
+  const int cx = m.m00 > 0 ? static_cast<int>(m.m10 / m.m00 * img.cols / mask.cols) : img.cols / 2;
+  img(cv::Rect(0, 0, cx, img.rows)).setTo(cv::Scalar(120, 125, 130));
+  return img;
+}
+
+// [cost] occlusion_budget (on by default): the area the observation lacks
+// compared with the model at the previous estimate is allowed as hidden, and
+// the track holds its shape instead of shrinking onto the visible half.
+TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  ASSERT_DOUBLE_EQ(config.cost.occlusion_budget, 1.0);
+  gtrack::Tracker tracker(setup, config);
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  tracker.set_estimate(truth);
+  const auto clean = tracker.process(scene(setup, truth, 1), 0, 0.0, 26.0);
+  EXPECT_DOUBLE_EQ(clean.outside_allowance, 0.0);
+  const double full = static_cast<double>(clean.observed_pixels);
+  for (int i = 1; i < 6; ++i) {
+    const auto e = tracker.process(half_covered(tracker, setup, truth, i + 1), i, i / 30.0, 26.0);
+    EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
+    // About half of the model is missing from O, and allowed for.
+    EXPECT_GT(e.outside_allowance, 0.3 * full) << "frame " << i;
+    EXPECT_LT(e.outside_allowance, 0.7 * full) << "frame " << i;
+    EXPECT_LT(e.terms.dice, 0.05) << "frame " << i;
+    EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
+    const double joints = (e.hypothesis.tail(6).array() - 30.0).abs().mean();
+    EXPECT_LT(joints, 10.0) << "frame " << i << ": " << e.hypothesis.transpose();
+  }
+  // Off: the paper's D, no allowance.
+  auto paper_config = config;
+  paper_config.cost.occlusion_budget = 0;
+  gtrack::Tracker paper(setup, paper_config);
+  paper.set_estimate(truth);
+  EXPECT_DOUBLE_EQ(paper.process(half_covered(paper, setup, truth, 9), 0, 0.0, 26.0).outside_allowance, 0.0);
+}
+
+// [tracker] redetect_dice: a track that sits on a wrong configuration while
+// the gripper is in plain view is replaced by the coarse search's result.
+TEST(Tracker, RedetectionReplacesAWrongTrack) {
+  auto setup = make_setup();
+  auto config = gtrack::engine_config(setup);
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  Eigen::VectorXd wrong = pose(0.9, 0.3, 45, 0);
+  wrong[3] = -20;
+  const cv::Mat img = scene(setup, truth, 3);
+  {
+    gtrack::Tracker tracker(setup, config);
+    tracker.set_estimate(wrong);
+    const auto e = tracker.process(img, 0, 0.0, 26.0);
+    EXPECT_TRUE(e.redetected);
+    EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
+    EXPECT_LT(e.terms.dice, 0.05);
+    EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << e.hypothesis.transpose();
+  }
+  {
+    config.tracker.redetect_dice = 1.0;  // the paper's tracker: never
+    gtrack::Tracker tracker(setup, config);
+    tracker.set_estimate(wrong);
+    const auto e = tracker.process(img, 0, 0.0, 26.0);
+    EXPECT_FALSE(e.redetected);
+    EXPECT_GT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.1) << e.hypothesis.transpose();
+  }
+}
+
 TEST(EngineConfig, PaperDefaults) {
   auto setup = make_setup();
   const auto c = gtrack::engine_config(setup);
@@ -381,27 +456,26 @@ TEST(EngineConfig, InitialPoseMustHaveEveryParameter) {
 
 namespace {
 
-// Not part of the suite (slow-ish): how often the coarse search lands on
-// random poses. Run with --gtest_also_run_disabled_tests.
-TEST(Tracker, DISABLED_CoarseSearchOnRandomPoses) {
+// The coarse search (first frame, after a loss, re-detection) on 20 random
+// poses of the folded or flat gripper: every one is found, in the image
+// plane and in its fold. (Tilt is left out: at 64 render pixels across, a
+// folded gripper's tilt sign is not decided by its outline.)
+TEST(Tracker, CoarseSearchFindsRandomPoses) {
   auto setup = make_setup();
   const auto config = gtrack::engine_config(setup);
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> xy(-1, 1), tilt(-30, 30), rz(-180, 180), q(0, 60);
-  int good = 0;
   for (int i = 0; i < 20; ++i) {
     Eigen::VectorXd h(12);
     h << xy(rng), xy(rng), 100.0, tilt(rng), tilt(rng), rz(rng), 0, 0, 0, 0, 0, 0;
     h.tail(6).setConstant(q(rng));
     gtrack::Tracker tracker(setup, config);
     const auto e = tracker.process(scene(setup, h, i), i, 0.0, std::nullopt);
-    const double pos = (e.hypothesis.head<2>() - h.head<2>()).norm() * 1000;
-    std::printf("pose %2d: D %.3f  xy err %.0f um  q %.0f->%.0f  tilt (%.0f,%.0f)->(%.0f,%.0f)  %.0f ms\n", i,
-                e.terms.dice, pos, h[6], e.hypothesis.tail(6).mean(), h[3], h[4], e.hypothesis[3], e.hypothesis[4],
-                e.ms);
-    good += e.terms.dice < 0.15;
+    EXPECT_EQ(e.status, gtrack::TrackStatus::Search);
+    EXPECT_LT(e.terms.dice, 0.1) << "pose " << i;
+    EXPECT_LT((e.hypothesis.head<2>() - h.head<2>()).norm(), 0.2) << "pose " << i;
+    EXPECT_LT(std::abs(e.hypothesis.tail(6).mean() - h[6]), 12.0) << "pose " << i;
   }
-  std::printf("%d/20 with D < 0.15\n", good);
 }
 
 }  // namespace

@@ -38,8 +38,15 @@ GTRACK_API double dice_distance(std::uint64_t intersection, std::uint64_t observ
 // w = 1 is dice_distance. With w < 1 a hypothesis whose silhouette spills
 // over where O is missing (an occluded part) is penalised less than one that
 // leaves observed pixels uncovered.
+//
+// allowance a, tolerance t: P\O pixels up to a + t are taken as hidden by an
+// occluder and not counted (only the excess is, weighted by w). With a set to
+// the area the observation lacks compared with the model's expected area,
+// the true configuration of a partly hidden gripper scores about 0, as it
+// would unoccluded, so shrinking or folding the hidden part away no longer
+// pays, while a hypothesis that grows beyond the expected area still does.
 GTRACK_API double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
-                                         double outside_weight);
+                                         double outside_weight, double allowance = 0, double tolerance = 0);
 
 // The temporal term T: mean over parameters of ((h_d - p_d) / sigma_d)^2, p
 // the prediction; rz (index 5) differences are taken the short way when
@@ -71,6 +78,14 @@ class GTRACK_API CostEvaluator {
   // Weight w of P\O in D (1 = plain D); clamped to [0, 1].
   void set_outside_weight(double w) { outside_weight_ = w < 0 ? 0 : (w > 1 ? 1 : w); }
   double outside_weight() const { return outside_weight_; }
+  // P\O pixels (render pixels, per view) not counted in D: the area the
+  // observation is believed to lack because of an occluder, and a tolerance
+  // on it (see weighted_dice_distance). 0 = plain D.
+  void set_outside_allowance(double pixels, double tolerance = 0) {
+    outside_allowance_ = pixels > 0 ? pixels : 0;
+    outside_tolerance_ = tolerance > 0 ? tolerance : 0;
+  }
+  double outside_allowance() const { return outside_allowance_; }
   const CostWeights& weights() const { return weights_; }
   std::uint64_t evaluations() const { return evaluations_; }
 
@@ -85,6 +100,8 @@ class GTRACK_API CostEvaluator {
   Eigen::VectorXd prediction_, sigma_;
   bool wrap_rz_ = true;
   double outside_weight_ = 1.0;
+  double outside_allowance_ = 0;
+  double outside_tolerance_ = 0;
 };
 
 }  // namespace gtrack

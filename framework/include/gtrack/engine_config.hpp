@@ -68,6 +68,11 @@ struct CostWeights {
   // O are weighted w = 1 - occlusion_discount * (1 - r) in D (see cost.hpp).
   // 0 = paper (w = 1 always).
   double occlusion_discount = 0.0;
+  // occlusion_budget b >= 0: when the observation is smaller than the model
+  // rendered at the previous estimate, P\O pixels up to b * (|P_prev| - |O|)
+  // (+ 5 % of |P_prev|) are taken as hidden and not counted in D (see
+  // cost.hpp). 0 = paper's D.
+  double occlusion_budget = 1.0;
 };
 
 struct SearchConfig {
@@ -86,6 +91,12 @@ struct TrackerConfig {
   int reinit_after_lost = 3;             // lost frames before the coarse search takes over
   int coarse_rz_steps = 12;              // rz hypotheses over one symmetry period
   int coarse_candidates = 4;             // best coarse hypotheses refined by a PSO each
+  bool coarse_wide_tilts = true;         // the coarse grid also tries 50 deg tilts (x, y, diagonals)
+  // Re-detection: when the tracked estimate's D is above this, the coarse
+  // search also runs on the frame and the lower-cost result is kept; it
+  // pulls a track that settled in a wrong basin back once the gripper is
+  // clearly seen. 1 = never (the paper's tracker).
+  double redetect_dice = 0.02;
   int mirror_particles = 2;              // particles started at the mirror tilt (-rx, -ry); 0 = paper's plain init
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4

@@ -70,7 +70,9 @@ struct Estimate {
   std::optional<double> stimulus;  // the reading used for this frame
   std::uint64_t observed_pixels = 0;  // |O|
   double outside_weight = 1;          // weight of P\O in D this frame ([cost] occlusion_discount)
+  double outside_allowance = 0;       // P\O pixels not counted in D this frame ([cost] occlusion_budget)
   std::uint64_t evaluations = 0;      // hypotheses scored for this frame
+  bool redetected = false;            // the coarse search's result replaced the tracked one
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
 };

@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <numbers>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 
@@ -36,7 +37,17 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
   const double period = 360.0 / std::max(1, model.geometry().symmetry_order);
   const int rz_steps = tc.coarse_rz_steps;
   const double tilt = 25.0;
-  const std::vector<std::pair<double, double>> tilts = {{0, 0}, {tilt, 0}, {-tilt, 0}, {0, tilt}, {0, -tilt}};
+  // Flat, then two rings of tilts: 25 deg about x or y, and 50 deg about x,
+  // y and the diagonals (strongly tilted, folded grippers have compact
+  // outlines that the first ring does not reach).
+  std::vector<std::pair<double, double>> tilts = {{0, 0}, {tilt, 0}, {-tilt, 0}, {0, tilt}, {0, -tilt}};
+  if (tc.coarse_wide_tilts) {
+    const double wide = 2 * tilt, diag = wide / std::numbers::sqrt2;
+    for (const auto& t : std::vector<std::pair<double, double>>{
+             {wide, 0}, {-wide, 0}, {0, wide}, {0, -wide}, {diag, diag}, {diag, -diag}, {-diag, diag}, {-diag, -diag}}) {
+      tilts.push_back(t);
+    }
+  }
   std::vector<double> joints;
   for (int j = 0; j < 4; ++j) joints.push_back(in.joint_lo + (in.joint_hi - in.joint_lo) * j / 3.0);
 

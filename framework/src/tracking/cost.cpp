@@ -17,11 +17,14 @@ double dice_distance(std::uint64_t intersection, std::uint64_t observed, std::ui
 }
 
 double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
-                              double outside_weight) {
+                              double outside_weight, double allowance, double tolerance) {
   if (intersection > rendered) intersection = rendered;
   const double w = outside_weight < 0 ? 0.0 : (outside_weight > 1 ? 1.0 : outside_weight);
   const double i = static_cast<double>(intersection);
-  const double outside = static_cast<double>(rendered - intersection);  // |P\O|
+  // |P\O| beyond the allowance (plus its tolerance): the part of the
+  // hypothesis that cannot be hidden by the occluder.
+  double outside = static_cast<double>(rendered - intersection);
+  if (allowance > 0) outside = std::max(0.0, outside - allowance - std::max(0.0, tolerance));
   const double denom = static_cast<double>(observed) + i + w * outside;  // 2|O&P| + |O\P| + w|P\O|
   if (denom <= 0) return rendered == 0 ? 0.0 : 1.0;
   const double d = 1.0 - 2.0 * i / denom;
@@ -73,7 +76,8 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     }
     const std::uint64_t observed = r->observation_count();
     for (int i = 0; i < n; ++i) {
-      out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_);
+      out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_,
+                                            outside_allowance_, outside_tolerance_);
     }
   }
   const double views = static_cast<double>(renderers_.size());

@@ -63,6 +63,7 @@ CostWeights read_cost(const ConfigTable& t) {
   c.stimulus = t.number_or("lambda_stimulus", c.stimulus, Range::non_negative());
   c.temporal = t.number_or("lambda_temporal", c.temporal, Range::non_negative());
   c.occlusion_discount = t.number_or("occlusion_discount", c.occlusion_discount, Range::closed(0.0, 1.0));
+  c.occlusion_budget = t.number_or("occlusion_budget", c.occlusion_budget, Range::closed(0.0, 4.0));
   return c;
 }
 
@@ -101,7 +102,10 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
 TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, const ParameterSpace& space) {
   TrackerConfig c;
   const double r = model.radius_mm();
-  const std::vector<double> spread_default = {0.1 * r, 0.1 * r, 0.1 * r, 10, 10, 10, 10};
+  // Depth is the weakly observed direction (near-orthographic views): a
+  // quarter of the in-plane spread, so that a flat cost in depth does not
+  // let it random-walk from frame to frame.
+  const std::vector<double> spread_default = {0.1 * r, 0.1 * r, 0.025 * r, 10, 10, 10, 10};
   const auto spread = t.numbers_or("init_spread", spread_default, 7, Range::non_negative());
   for (int i = 0; i < 7; ++i) c.init_spread[i] = spread[i];
   const auto pose = t.numbers_or("initial_pose", {});
@@ -121,6 +125,8 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.reinit_after_lost = static_cast<int>(t.integer_or("reinit_after_lost", c.reinit_after_lost, Range::closed(1, 1e6)));
   c.coarse_rz_steps = static_cast<int>(t.integer_or("coarse_rz_steps", c.coarse_rz_steps, Range::closed(1, 360)));
   c.coarse_candidates = static_cast<int>(t.integer_or("coarse_candidates", c.coarse_candidates, Range::closed(1, 64)));
+  c.coarse_wide_tilts = t.boolean_or("coarse_wide_tilts", c.coarse_wide_tilts);
+  c.redetect_dice = t.number_or("redetect_dice", c.redetect_dice, Range::closed(0.0, 1.0));
   c.mirror_particles = static_cast<int>(t.integer_or("mirror_particles", c.mirror_particles, Range::closed(0, 1 << 16)));
   c.progress_every = static_cast<int>(t.integer_or("progress_every", c.progress_every, Range::closed(1, 1e9)));
   c.overlay = t.boolean_or("overlay", c.overlay);

@@ -61,7 +61,9 @@ void ResultWriter::write(const Estimate& e) {
        num(e.ms, "%.3f");
   j += ",\"D\":" + num(e.terms.dice, "%.6f") + ",\"K\":" + num(e.terms.kinematic, "%.6f") +
        ",\"S\":" + num(e.terms.stimulus, "%.6f") + ",\"T\":" + num(e.terms.temporal, "%.6f") +
-       ",\"outside_weight\":" + num(e.outside_weight, "%.4f");
+       ",\"outside_weight\":" + num(e.outside_weight, "%.4f") +
+       ",\"outside_allowance\":" + num(e.outside_allowance, "%.1f") + ",\"redetected\":" +
+       (e.redetected ? "true" : "false");
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);

@@ -149,6 +149,15 @@ struct Tracker::Impl {
       outside_weight = 1.0 - config.cost.occlusion_discount * (1.0 - r);
     }
     cost->set_outside_weight(outside_weight);
+    double allowance = 0, tolerance = 0;
+    if (!searching && config.cost.occlusion_budget > 0 && previous_area > 0) {
+      const double expected = static_cast<double>(previous_area);
+      allowance = config.cost.occlusion_budget * (expected - static_cast<double>(observation.count));
+      tolerance = 0.05 * expected;
+      if (allowance < tolerance) allowance = 0;
+    }
+    cost->set_outside_allowance(allowance, tolerance);
+    e.outside_allowance = cost->outside_allowance();
     e.outside_weight = cost->outside_weight();
     e.observed_pixels = observation.count;
     e.times.segment_ms = ms_since(t0);
@@ -164,27 +173,29 @@ struct Tracker::Impl {
     } else {
       renderer->set_observation(observation.mask);
       const std::uint64_t evals0 = cost->evaluations();
+      std::uint64_t bookkeeping = 0;  // single scores of a result, not the search's
       Eigen::VectorXd best;
       if (searching && !started && config.tracker.initial_pose) {
         best = optimise(*config.tracker.initial_pose, stimulus_on, rng);
         e.status = TrackStatus::Tracked;
       } else if (searching) {
-        const auto [jlo, jhi] = joint_range(stimulus_on);
-        detail::CoarseSearchInput in;
-        in.observation = &observation.mask;
-        in.render_projection = render_projection;
-        in.nominal_mm = setup.sensor->nominal_position_mm();
-        in.model = &setup.model();
-        in.joint_lo = jlo;
-        in.joint_hi = jhi;
-        best = detail::coarse_search(in, config, *cost, rng).best;
+        best = coarse(stimulus_on, rng).best;
         e.status = TrackStatus::Search;
         reference_area = 0;
       } else {
         best = optimise(*last, stimulus_on, rng, prediction ? &*prediction : nullptr);
         e.status = TrackStatus::Tracked;
+        const CostTerms tracked = cost->evaluate_one(best);
+        ++bookkeeping;
+        if (tracked.dice > config.tracker.redetect_dice) {
+          const auto found = coarse(stimulus_on, rng);
+          if (found.cost < tracked.total) {
+            best = found.best;
+            e.redetected = true;
+          }
+        }
       }
-      e.evaluations = cost->evaluations() - evals0;
+      e.evaluations = cost->evaluations() - evals0 - bookkeeping;
       e.terms = cost->evaluate_one(best);
       if (e.terms.dice > config.tracker.lost_dice) {
         ++lost;
@@ -207,6 +218,18 @@ struct Tracker::Impl {
     e.times.pso_ms = ms_since(t1);
     e.ms = ms_since(t0);
     return e;
+  }
+
+  detail::CoarseSearchResult coarse(bool stimulus_on, std::mt19937_64& rng) {
+    const auto [jlo, jhi] = joint_range(stimulus_on);
+    detail::CoarseSearchInput in;
+    in.observation = &observation.mask;
+    in.render_projection = render_projection;
+    in.nominal_mm = setup.sensor->nominal_position_mm();
+    in.model = &setup.model();
+    in.joint_lo = jlo;
+    in.joint_hi = jhi;
+    return detail::coarse_search(in, config, *cost, rng);
   }
 
   // Constant velocity: last + (last - before_last), rz the short way; the
