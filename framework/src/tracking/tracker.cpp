@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include "coarse_search.hpp"
 #include "gtrack/error.hpp"
@@ -188,8 +189,13 @@ struct Tracker::Impl {
         const CostTerms tracked = cost->evaluate_one(best);
         ++bookkeeping;
         if (tracked.dice > config.tracker.redetect_dice) {
+          // Compared without the temporal term: the point is to leave the
+          // predicted configuration when the image says it is wrong.
           const auto found = coarse(stimulus_on, rng);
-          if (found.cost < tracked.total) {
+          const CostTerms alternative = cost->evaluate_one(found.best);
+          ++bookkeeping;
+          const double lt = config.cost.temporal;
+          if (alternative.total - lt * alternative.temporal < tracked.total - lt * tracked.temporal) {
             best = found.best;
             e.redetected = true;
           }
@@ -239,6 +245,9 @@ struct Tracker::Impl {
     if (before_last && before_last->size() == last->size()) {
       Eigen::VectorXd v = *last - *before_last;
       if (v.size() > 5) v[5] = std::remainder(v[5], 360.0);
+      // Depth is seen too weakly for its frame-to-frame change to be a
+      // velocity (it is mostly noise): it is predicted to stay.
+      v[2] = 0;
       p += v;
     }
     config.space.clamp(p);
