@@ -96,7 +96,8 @@ struct TrackerConfig {
   // search also runs on the frame and the lower-cost result is kept; it
   // pulls a track that settled in a wrong basin back once the gripper is
   // clearly seen. 1 = never (the paper's tracker).
-  double redetect_dice = 0.02;
+  double redetect_dice = 0.01;
+  bool mirror_check = true;              // score the tilt mirror of every result and keep the lower
   int mirror_particles = 2;              // particles started at the mirror tilt (-rx, -ry); 0 = paper's plain init
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4

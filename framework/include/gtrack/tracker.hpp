@@ -73,6 +73,7 @@ struct Estimate {
   double outside_allowance = 0;       // P\O pixels not counted in D this frame ([cost] occlusion_budget)
   std::uint64_t evaluations = 0;      // hypotheses scored for this frame
   bool redetected = false;            // the coarse search's result replaced the tracked one
+  bool mirrored = false;              // the tilt mirror of the result scored lower and replaced it
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
 };

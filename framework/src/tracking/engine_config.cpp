@@ -126,6 +126,7 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.coarse_rz_steps = static_cast<int>(t.integer_or("coarse_rz_steps", c.coarse_rz_steps, Range::closed(1, 360)));
   c.coarse_candidates = static_cast<int>(t.integer_or("coarse_candidates", c.coarse_candidates, Range::closed(1, 64)));
   c.coarse_wide_tilts = t.boolean_or("coarse_wide_tilts", c.coarse_wide_tilts);
+  c.mirror_check = t.boolean_or("mirror_check", c.mirror_check);
   c.redetect_dice = t.number_or("redetect_dice", c.redetect_dice, Range::closed(0.0, 1.0));
   c.mirror_particles = static_cast<int>(t.integer_or("mirror_particles", c.mirror_particles, Range::closed(0, 1 << 16)));
   c.progress_every = static_cast<int>(t.integer_or("progress_every", c.progress_every, Range::closed(1, 1e9)));

@@ -63,7 +63,7 @@ void ResultWriter::write(const Estimate& e) {
        ",\"S\":" + num(e.terms.stimulus, "%.6f") + ",\"T\":" + num(e.terms.temporal, "%.6f") +
        ",\"outside_weight\":" + num(e.outside_weight, "%.4f") +
        ",\"outside_allowance\":" + num(e.outside_allowance, "%.1f") + ",\"redetected\":" +
-       (e.redetected ? "true" : "false");
+       (e.redetected ? "true" : "false") + ",\"mirrored\":" + (e.mirrored ? "true" : "false");
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);

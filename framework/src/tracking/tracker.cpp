@@ -3,7 +3,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 
 #include "coarse_search.hpp"
 #include "gtrack/error.hpp"
@@ -48,6 +47,10 @@ struct Tracker::Impl {
   std::optional<Eigen::VectorXd> before_last;  // the estimate before `last`, both tracked: the velocity
   std::uint64_t reference_area = 0;  // |P| when O last covered the whole model (0 = none yet)
   static constexpr double kCompleteRatio = 0.9;
+  // Below this tilt (deg) a result and its mirror are the same configuration.
+  static constexpr double kMirrorMinTiltDeg = 3.0;
+  // Re-detection replaces the track when its cost is below this share of the track's.
+  static constexpr double kRedetectGain = 0.7;
   bool started = false;  // a frame has been processed since construction or reset
   int lost = 0;          // consecutive lost frames
   Observation observation;
@@ -195,10 +198,36 @@ struct Tracker::Impl {
           const CostTerms alternative = cost->evaluate_one(found.best);
           ++bookkeeping;
           const double lt = config.cost.temporal;
-          if (alternative.total - lt * alternative.temporal < tracked.total - lt * tracked.temporal) {
+          // Only a clear gain counts: under occlusion many configurations
+          // explain what is visible about equally well, and trading the
+          // track for one of them on a marginal gain is a jump, not a fix.
+          if (alternative.total - lt * alternative.temporal <
+              kRedetectGain * (tracked.total - lt * tracked.temporal)) {
             best = found.best;
             e.redetected = true;
           }
+        }
+      }
+      if (config.tracker.mirror_check && std::hypot(best[3], best[4]) > kMirrorMinTiltDeg) {
+        // The tilt mirror of the result, (rx, ry) -> (-rx, -ry): seen along
+        // the optical axis its outline differs only through perspective, so
+        // a swarm that settled on one branch rarely crosses to the other. A
+        // short swarm refines the mirror (the branch's depth and tilt
+        // compensate each other, so the bare mirror scores worse than it
+        // should) and the lower of the two is kept.
+        Eigen::VectorXd mirror = best;
+        mirror[3] = -mirror[3];
+        mirror[4] = -mirror[4];
+        config.space.clamp(mirror);
+        PsoConfig small = config.pso;
+        small.particles = std::max(4, config.pso.particles / 2);
+        small.generations = std::max(2, config.pso.generations / 2);
+        const PsoResult m = optimise_with(small, mirror, stimulus_on, rng);
+        const double current = cost->evaluate_one(best).total;
+        ++bookkeeping;
+        if (m.best_cost < current) {
+          best = m.best;
+          e.mirrored = true;
         }
       }
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
@@ -256,11 +285,16 @@ struct Tracker::Impl {
 
   Eigen::VectorXd optimise(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng,
                            const Eigen::VectorXd* prediction = nullptr) {
+    return optimise_with(config.pso, from, stimulus_on, rng, prediction).best;
+  }
+
+  PsoResult optimise_with(const PsoConfig& pso_config, const Eigen::VectorXd& from, bool stimulus_on,
+                          std::mt19937_64& rng, const Eigen::VectorXd* prediction = nullptr) {
     const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
     const Eigen::VectorXd s = spread();
     Eigen::VectorXd start = from;
     config.space.clamp(start);
-    Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, config.pso.particles, config.space, rng);
+    Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, pso_config.particles, config.space, rng);
     // Seen along the optical axis, a flat gripper tilted by (rx, ry) and by
     // (-rx, -ry) casts the same silhouette. The last few particles explore
     // the mirror tilt, so a track that picked the wrong one while the
@@ -274,11 +308,9 @@ struct Tracker::Impl {
     // Particle 1 starts at the constant-velocity prediction (particle 0 stays
     // at the previous best, as in the paper).
     if (prediction && config.cost.temporal > 0 && init.cols() - mirrors > 1) init.col(1) = *prediction;
-    ParticleSwarm pso(config.pso, config.space);
+    ParticleSwarm pso(pso_config, config.space);
     pso.set_randomization_spread(s);
-    const PsoResult r = pso.run(
-        init, [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
-    return r.best;
+    return pso.run(init, [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
   }
 };
 
