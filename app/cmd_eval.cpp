@@ -15,8 +15,8 @@ namespace {
 
 void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) {
   std::cout << "  " << std::left << std::setw(22) << name << std::right << std::fixed << std::setprecision(2)
-            << std::setw(9) << s.mean << " +- " << std::setw(7) << s.std << "  max " << std::setw(8) << s.max << " "
-            << unit << "\n";
+            << std::setw(9) << s.mean << " +- " << std::setw(7) << s.std << "  median " << std::setw(8) << s.median
+            << "  max " << std::setw(8) << s.max << " " << unit << "\n";
 }
 
 int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {

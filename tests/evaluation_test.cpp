@@ -101,7 +101,12 @@ TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
   EXPECT_EQ(ev.recovery[0].frames_to_recover, 2);
   EXPECT_TRUE(ev.recovery[0].recovered);
   EXPECT_EQ(ev.frames_lost_after_return, 2);
+  // In-plane errors of the evaluated frames 0, 1, 6, 8: 0, 0, 1500, 0 um.
+  EXPECT_NEAR(ev.in_view.position_inplane_um.mean, 375, 1e-6);
+  EXPECT_NEAR(ev.in_view.position_inplane_um.median, 0, 1e-6);
+  EXPECT_NEAR(ev.in_view.position_inplane_um.max, 1500, 1e-6);
   const std::string json = gtrack::evaluation_json(ev);
+  EXPECT_NE(json.find("\"median\": "), std::string::npos);
   for (const char* key : {"\"position_um\"", "\"position_inplane_um\"", "\"depth_um\"", "\"orientation_deg\"",
                           "\"joint_deg\"", "\"endpoint_um\"", "\"lost_frames\": 5", "\"recovery\""}) {
     EXPECT_NE(json.find(key), std::string::npos) << key;

@@ -42,6 +42,7 @@ struct EvalOptions {
 
 struct ErrorStats {
   double mean = 0, std = 0, max = 0;
+  double median = 0;  // robust to the few frames of a track that drifted off
   int count = 0;
 };
 

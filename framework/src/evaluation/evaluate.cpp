@@ -21,6 +21,13 @@ ErrorStats stats(const std::vector<double>& v) {
   s.mean = sum / v.size();
   for (double x : v) sq += (x - s.mean) * (x - s.mean);
   s.std = std::sqrt(sq / v.size());
+  std::vector<double> sorted = v;
+  const size_t mid = sorted.size() / 2;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(mid), sorted.end());
+  s.median = sorted[mid];
+  if (sorted.size() % 2 == 0) {
+    s.median = 0.5 * (s.median + *std::max_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(mid)));
+  }
   return s;
 }
 

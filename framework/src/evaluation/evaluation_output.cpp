@@ -19,7 +19,8 @@ std::string num(double v) {
 }
 
 std::string stats_json(const ErrorStats& s) {
-  return "{\"mean\": " + num(s.mean) + ", \"std\": " + num(s.std) + ", \"max\": " + num(s.max) +
+  return "{\"mean\": " + num(s.mean) + ", \"std\": " + num(s.std) + ", \"median\": " + num(s.median) +
+         ", \"max\": " + num(s.max) +
          ", \"count\": " + std::to_string(s.count) + "}";
 }
 
