@@ -51,6 +51,8 @@ struct Tracker::Impl {
   static constexpr double kMirrorMinTiltDeg = 3.0;
   // Re-detection replaces the track when its cost is below this share of the track's.
   static constexpr double kRedetectGain = 0.7;
+  // Spread multiplier of the re-detection's local swarm.
+  static constexpr double kWideSpread = 3.0;
   bool started = false;  // a frame has been processed since construction or reset
   int lost = 0;          // consecutive lost frames
   Observation observation;
@@ -161,6 +163,10 @@ struct Tracker::Impl {
       if (allowance < tolerance) allowance = 0;
     }
     cost->set_outside_allowance(allowance, tolerance);
+    // Share of the model at the previous estimate that is observed now.
+    const double visible =
+        previous_area > observation.count ? static_cast<double>(observation.count) / static_cast<double>(previous_area)
+                                          : 1.0;
     e.outside_allowance = cost->outside_allowance();
     e.outside_weight = cost->outside_weight();
     e.observed_pixels = observation.count;
@@ -194,15 +200,26 @@ struct Tracker::Impl {
         if (tracked.dice > config.tracker.redetect_dice) {
           // Compared without the temporal term: the point is to leave the
           // predicted configuration when the image says it is wrong.
-          const auto found = coarse(stimulus_on, rng);
+          auto found = coarse(stimulus_on, rng);
+          // And a swarm around the track with three times the spreads: the
+          // right configuration is often a nearby basin the coarse grid's
+          // steps do not reach (strong tilts, partly hidden).
+          {
+            const PsoResult wide = optimise_with(config.pso, best, stimulus_on, rng, nullptr, kWideSpread);
+            if (wide.best_cost < found.cost) {
+              found.best = wide.best;
+              found.cost = wide.best_cost;
+            }
+          }
           const CostTerms alternative = cost->evaluate_one(found.best);
           ++bookkeeping;
           const double lt = config.cost.temporal;
           // Only a clear gain counts: under occlusion many configurations
           // explain what is visible about equally well, and trading the
           // track for one of them on a marginal gain is a jump, not a fix.
+          // The more of the model is hidden, the larger the gain required.
           if (alternative.total - lt * alternative.temporal <
-              kRedetectGain * (tracked.total - lt * tracked.temporal)) {
+              kRedetectGain * visible * (tracked.total - lt * tracked.temporal)) {
             best = found.best;
             e.redetected = true;
           }
@@ -289,9 +306,10 @@ struct Tracker::Impl {
   }
 
   PsoResult optimise_with(const PsoConfig& pso_config, const Eigen::VectorXd& from, bool stimulus_on,
-                          std::mt19937_64& rng, const Eigen::VectorXd* prediction = nullptr) {
+                          std::mt19937_64& rng, const Eigen::VectorXd* prediction = nullptr,
+                          double spread_scale = 1.0) {
     const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
-    const Eigen::VectorXd s = spread();
+    const Eigen::VectorXd s = spread() * spread_scale;
     Eigen::VectorXd start = from;
     config.space.clamp(start);
     Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, pso_config.particles, config.space, rng);
