@@ -52,5 +52,5 @@ run_setup() {  # run_setup NAME CONFIG FRAMES MAX_INPLANE_UM MAX_ORIENT_DEG MAX_
 # near-orthographic silhouette, so orientation is not held to a bound here.
 run_setup examples examples/example_setup.toml 30 "${EXAMPLE_MAX_UM:-60}" "${EXAMPLE_MAX_DEG:-180}" "${EXAMPLE_MAX_JOINT_DEG:-15}"
 run_setup custom_gripper "$prefix/share/gtrack/configs/microscope_custom_gripper.toml" 60 \
-  "${CUSTOM_MAX_UM:-150}" "${CUSTOM_MAX_DEG:-60}" "${CUSTOM_MAX_JOINT_DEG:-15}"
+  "${CUSTOM_MAX_UM:-100}" "${CUSTOM_MAX_DEG:-30}" "${CUSTOM_MAX_JOINT_DEG:-10}"
 echo "ci_examples: passed"

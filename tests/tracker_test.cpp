@@ -453,6 +453,13 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(c.cost.stimulus, 1.0);
   EXPECT_DOUBLE_EQ(c.cost.temporal, 0.0);            // lambda_temporal: paper
   EXPECT_DOUBLE_EQ(c.cost.occlusion_discount, 0.0);  // paper
+  // Additions on by default (docs/tracker.md); each has a value that turns it off.
+  EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
+  EXPECT_DOUBLE_EQ(c.tracker.redetect_dice, 0.01);
+  EXPECT_TRUE(c.tracker.mirror_check);
+  EXPECT_TRUE(c.tracker.coarse_wide_tilts);
+  // Depth spread: a quarter of the in-plane one (model radius 2 mm).
+  EXPECT_NEAR(c.tracker.init_spread[2], 0.25 * c.tracker.init_spread[0], 1e-12);
   EXPECT_EQ(c.space.dims(), 12);
   EXPECT_TRUE(c.space.periodic[5]);
 }
