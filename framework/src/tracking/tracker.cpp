@@ -133,9 +133,9 @@ struct Tracker::Impl {
       observation = segmenter->observe(frame, nullptr);
     }
     // Occlusion handling (docs/tracker.md, "Partial occlusion"): the
-    // constant-velocity prediction for the temporal term, and the weight of
-    // rendered pixels outside O when O is smaller than the model at the
-    // previous estimate.
+    // constant-velocity prediction for the temporal term, and, when O is
+    // smaller than the model at the previous estimate, the weight of rendered
+    // pixels outside O and the area of them taken as hidden (the budget).
     std::optional<Eigen::VectorXd> prediction;
     if (!searching) prediction = predict();
     if (prediction && config.cost.temporal > 0) {
@@ -198,12 +198,11 @@ struct Tracker::Impl {
         const CostTerms tracked = cost->evaluate_one(best);
         ++bookkeeping;
         if (tracked.dice > config.tracker.redetect_dice) {
-          // Compared without the temporal term: the point is to leave the
-          // predicted configuration when the image says it is wrong.
+          // Re-detection: the coarse search, and a swarm around the track
+          // with three times the spreads (the right configuration is often a
+          // nearby basin the coarse grid's steps do not reach: strong tilts,
+          // partly hidden).
           auto found = coarse(stimulus_on, rng);
-          // And a swarm around the track with three times the spreads: the
-          // right configuration is often a nearby basin the coarse grid's
-          // steps do not reach (strong tilts, partly hidden).
           {
             const PsoResult wide = optimise_with(config.pso, best, stimulus_on, rng, nullptr, kWideSpread);
             if (wide.best_cost < found.cost) {
@@ -214,7 +213,9 @@ struct Tracker::Impl {
           const CostTerms alternative = cost->evaluate_one(found.best);
           ++bookkeeping;
           const double lt = config.cost.temporal;
-          // Only a clear gain counts: under occlusion many configurations
+          // Compared without the temporal term: the point is to leave the
+          // predicted configuration when the image says it is wrong. And
+          // only a clear gain counts: under occlusion many configurations
           // explain what is visible about equally well, and trading the
           // track for one of them on a marginal gain is a jump, not a fix.
           // The more of the model is hidden, the larger the gain required.
