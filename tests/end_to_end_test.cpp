@@ -65,7 +65,7 @@ TEST_P(EndToEnd, SyntheticSequenceIsTracked) {
 }
 
 // One per setup of the paper; the configs are the shipped ones. Measured on
-// these sequences (in-plane): 26, 2.1, 3.6 and 63 um. A lost track is off by
+// these sequences (in-plane): 18, 2.1, 3.6 and 63 um. A lost track is off by
 // a gripper radius or more (2000, 450, 375 and 2000 um): the bounds sit
 // between, scaled to each setup's pixel size.
 INSTANTIATE_TEST_SUITE_P(

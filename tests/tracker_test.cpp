@@ -412,6 +412,24 @@ TEST(Tracker, RedetectionReplacesAWrongTrack) {
   }
 }
 
+// Re-detection looks at the whole image: a track 2 mm off has its ROI and
+// prior around the wrong place, which cut away most of the gripper.
+TEST(Tracker, RedetectionSearchesTheWholeImage) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  const Eigen::VectorXd wrong = pose(2.3, -0.2, 20, 30);
+  const cv::Mat img = scene(setup, truth, 5);
+  gtrack::Tracker fresh(setup, config);
+  const std::uint64_t whole = fresh.process(img, 0, 0.0, 26.0).observed_pixels;
+  gtrack::Tracker tracker(setup, config);
+  tracker.set_estimate(wrong);
+  const auto e = tracker.process(img, 0, 0.0, 26.0);
+  EXPECT_TRUE(e.redetected);
+  EXPECT_EQ(e.observed_pixels, whole);
+  EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << e.hypothesis.transpose();
+}
+
 // [tracker] mirror_check: a track that starts on the mirror tilt of a folded,
 // tilted gripper crosses to the right one in a frame.
 TEST(Tracker, MirrorCheckLeavesTheMirrorTilt) {

@@ -155,14 +155,7 @@ struct Tracker::Impl {
       outside_weight = 1.0 - config.cost.occlusion_discount * (1.0 - r);
     }
     cost->set_outside_weight(outside_weight);
-    double allowance = 0, tolerance = 0;
-    if (!searching && config.cost.occlusion_budget > 0 && previous_area > 0) {
-      const double expected = static_cast<double>(previous_area);
-      allowance = config.cost.occlusion_budget * (expected - static_cast<double>(observation.count));
-      tolerance = 0.05 * expected;
-      if (allowance < tolerance) allowance = 0;
-    }
-    cost->set_outside_allowance(allowance, tolerance);
+    set_allowance(searching ? 0 : previous_area);
     // Share of the model at the previous estimate that is observed now.
     const double visible =
         previous_area > observation.count ? static_cast<double>(observation.count) / static_cast<double>(previous_area)
@@ -202,6 +195,21 @@ struct Tracker::Impl {
           // with three times the spreads (the right configuration is often a
           // nearby basin the coarse grid's steps do not reach: strong tilts,
           // partly hidden).
+          // The search looks at the whole image: the ROI and the temporal
+          // prior were placed around the track, and when the track is wrong
+          // they cut away the gripper it should find. The track is scored
+          // again on the same observation, so that the two compare fairly.
+          const Observation trimmed = observation;
+          const Observation whole = segmenter->observe(frame, nullptr);
+          const bool widened = whole.count > observation.count;
+          CostTerms current = tracked;
+          if (widened) {
+            observation = whole;
+            renderer->set_observation(observation.mask);
+            set_allowance(previous_area);
+            current = cost->evaluate_one(best);
+            ++bookkeeping;
+          }
           auto found = coarse(stimulus_on, rng);
           {
             const PsoResult wide = optimise_with(config.pso, best, stimulus_on, rng, nullptr, kWideSpread);
@@ -220,9 +228,13 @@ struct Tracker::Impl {
           // track for one of them on a marginal gain is a jump, not a fix.
           // The more of the model is hidden, the larger the gain required.
           if (alternative.total - lt * alternative.temporal <
-              kRedetectGain * visible * (tracked.total - lt * tracked.temporal)) {
+              kRedetectGain * visible * (current.total - lt * current.temporal)) {
             best = found.best;
             e.redetected = true;
+          } else if (widened) {
+            observation = trimmed;
+            renderer->set_observation(observation.mask);
+            set_allowance(previous_area);
           }
         }
       }
@@ -249,6 +261,8 @@ struct Tracker::Impl {
         }
       }
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
+      e.outside_allowance = cost->outside_allowance();  // re-detection may have widened O
+      e.observed_pixels = observation.count;
       e.terms = cost->evaluate_one(best);
       if (e.terms.dice > config.tracker.lost_dice) {
         ++lost;
@@ -271,6 +285,19 @@ struct Tracker::Impl {
     e.times.pso_ms = ms_since(t1);
     e.ms = ms_since(t0);
     return e;
+  }
+
+  // The occlusion budget for the current observation against the model's
+  // area at the previous estimate (0: none, e.g. when searching).
+  void set_allowance(std::uint64_t previous_area) {
+    double allowance = 0, tolerance = 0;
+    if (config.cost.occlusion_budget > 0 && previous_area > 0) {
+      const double expected = static_cast<double>(previous_area);
+      allowance = config.cost.occlusion_budget * (expected - static_cast<double>(observation.count));
+      tolerance = 0.05 * expected;
+      if (allowance < tolerance) allowance = 0;
+    }
+    cost->set_outside_allowance(allowance, tolerance);
   }
 
   detail::CoarseSearchResult coarse(bool stimulus_on, std::mt19937_64& rng) {
