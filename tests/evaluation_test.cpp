@@ -85,8 +85,11 @@ TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
   // Frames 0-1 tracked, 2 lost, 3 missing, 4-5 out of view, 6-7 back in view
   // but off track, 8 on track again.
   for (int f = 0; f < 9; ++f) truth.rows.push_back(row(f, h, "", (f == 4 || f == 5) ? 0.0 : 1.0));
-  est.rows = {row(0, h), row(1, h), row(2, h, "lost"), row(4, h, "lost"), row(5, h, "lost"),
-              row(6, far), row(7, h, "lost"), row(8, h)};
+  Eigen::VectorXd near10 = h, near20 = h;
+  near10[0] += 0.010;  // 10 um off
+  near20[1] += 0.020;  // 20 um off
+  est.rows = {row(0, h), row(1, near10), row(2, h, "lost"), row(4, h, "lost"), row(5, h, "lost"),
+              row(6, far), row(7, h, "lost"), row(8, near20)};
   const auto ev = gtrack::evaluate(m, truth, est);
   EXPECT_EQ(ev.frames, 9);
   EXPECT_EQ(ev.out_of_view_frames, 2);
@@ -101,9 +104,9 @@ TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
   EXPECT_EQ(ev.recovery[0].frames_to_recover, 2);
   EXPECT_TRUE(ev.recovery[0].recovered);
   EXPECT_EQ(ev.frames_lost_after_return, 2);
-  // In-plane errors of the evaluated frames 0, 1, 6, 8: 0, 0, 1500, 0 um.
-  EXPECT_NEAR(ev.in_view.position_inplane_um.mean, 375, 1e-6);
-  EXPECT_NEAR(ev.in_view.position_inplane_um.median, 0, 1e-6);
+  // In-plane errors of the evaluated frames 0, 1, 6, 8: 0, 10, 1500, 20 um.
+  EXPECT_NEAR(ev.in_view.position_inplane_um.mean, 382.5, 1e-6);
+  EXPECT_NEAR(ev.in_view.position_inplane_um.median, 15, 1e-6);
   EXPECT_NEAR(ev.in_view.position_inplane_um.max, 1500, 1e-6);
   const std::string json = gtrack::evaluation_json(ev);
   EXPECT_NE(json.find("\"median\": "), std::string::npos);

@@ -118,7 +118,8 @@ TEST(Tracker, CoarseSearchFindsTheGripperOnTheFirstFrame) {
 
 TEST(Tracker, FollowsAMovingFoldingGripper) {
   auto setup = make_setup();
-  const auto config = gtrack::engine_config(setup);
+  auto config = gtrack::engine_config(setup);
+  config.tracker.redetect_dice = 1.0;  // the swarm's own budget (re-detection has its tests)
   gtrack::Tracker tracker(setup, config);
   tracker.set_estimate(pose(0.3, -0.2, 20, 5));
   for (int i = 0; i < 8; ++i) {
@@ -126,9 +127,9 @@ TEST(Tracker, FollowsAMovingFoldingGripper) {
     const auto e = tracker.process(scene(setup, truth, i + 1), i, i / 30.0, 22.0 + i);
     EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
     // N x G per tracked frame, plus the mirror check's N/2 x G/2 (the
-    // gripper is tilted by 10 deg), plus the coarse search's when it ran.
-    if (!e.redetected && e.terms.dice <= config.tracker.redetect_dice) EXPECT_EQ(e.evaluations, 32u * 25u + 16u * 12u);
-    EXPECT_GE(e.evaluations, 32u * 25u + 16u * 12u);
+    // gripper is tilted by 10 deg).
+    EXPECT_FALSE(e.redetected);
+    EXPECT_EQ(e.evaluations, 32u * 25u + 16u * 12u);
     EXPECT_LT(e.terms.dice, 0.12) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
   }
@@ -376,12 +377,16 @@ TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
     const double joints = (e.hypothesis.tail(6).array() - 30.0).abs().mean();
     EXPECT_LT(joints, 10.0) << "frame " << i << ": " << e.hypothesis.transpose();
   }
-  // Off: the paper's D, no allowance.
+  // Off: the paper's D, no allowance; the true configuration of the half
+  // hidden gripper then pays for its hidden half, and the track gives way.
   auto paper_config = config;
   paper_config.cost.occlusion_budget = 0;
   gtrack::Tracker paper(setup, paper_config);
   paper.set_estimate(truth);
-  EXPECT_DOUBLE_EQ(paper.process(half_covered(paper, setup, truth, 9), 0, 0.0, 26.0).outside_allowance, 0.0);
+  gtrack::Estimate p;
+  for (int i = 1; i < 6; ++i) p = paper.process(half_covered(paper, setup, truth, i + 1), i, i / 30.0, 26.0);
+  EXPECT_DOUBLE_EQ(p.outside_allowance, 0.0);
+  EXPECT_GT(p.terms.dice, 0.1);
 }
 
 // [tracker] redetect_dice: a track that sits on a wrong configuration while

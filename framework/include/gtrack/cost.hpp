@@ -39,8 +39,9 @@ GTRACK_API double dice_distance(std::uint64_t intersection, std::uint64_t observ
 // over where O is missing (an occluded part) is penalised less than one that
 // leaves observed pixels uncovered.
 //
-// allowance a, tolerance t: P\O pixels up to a + t are taken as hidden by an
-// occluder and not counted (only the excess is, weighted by w). With a set to
+// allowance a > 0, tolerance t: P\O pixels up to a + t are taken as hidden by
+// an occluder and not counted (only the excess is, weighted by w); a = 0 is
+// no allowance at all (t is ignored). With a set to
 // the area the observation lacks compared with the model's expected area,
 // the true configuration of a partly hidden gripper scores about 0, as it
 // would unoccluded, so shrinking or folding the hidden part away no longer

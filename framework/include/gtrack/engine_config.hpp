@@ -5,7 +5,8 @@
 // (segmentation), [pso] (Algorithm 1), [cost] (eq. 1 weights), [render]
 // (backend and scale), [search] (bounds of the hypothesis space) and
 // [tracker] (initial pose, initial spreads, frame rate, lost handling).
-// engine_config() reads all of them, with the paper's defaults, and checks
+// engine_config() reads all of them, with the paper's defaults except for the
+// additions docs/tracker.md lists (each can be turned off), and checks
 // that each table holds no unknown key (file, line, key, suggestion).
 // Defaults that depend on the setup (search box, spreads) are derived from the
 // sensor's nominal position and the model's size.
@@ -93,11 +94,12 @@ struct TrackerConfig {
   int coarse_candidates = 4;             // best coarse hypotheses refined by a PSO each
   bool coarse_wide_tilts = true;         // the coarse grid also tries 50 deg tilts (x, y, diagonals)
   // Re-detection: when the tracked estimate's D is above this, the coarse
-  // search also runs on the frame and the lower-cost result is kept; it
-  // pulls a track that settled in a wrong basin back once the gripper is
-  // clearly seen. 1 = never (the paper's tracker).
+  // search and a wide swarm also run on the frame, and their result replaces
+  // the track on a clear gain (docs/tracker.md); it pulls a track that
+  // settled in a wrong basin back once the gripper is clearly seen.
+  // 1 = never (the paper's tracker).
   double redetect_dice = 0.01;
-  bool mirror_check = true;              // score the tilt mirror of every result and keep the lower
+  bool mirror_check = true;              // refine the tilt mirror of a tilted (> 3 deg) result, keep the lower
   int mirror_particles = 2;              // particles started at the mirror tilt (-rx, -ry); 0 = paper's plain init
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4

@@ -1,10 +1,12 @@
-// The first-frame (and recovery) search: where is the gripper, roughly?
+// The search for the first frame, after a loss, and for re-detection: where
+// is the gripper, roughly?
 //
 // The observation's centroid is lifted to 3D at the sensor's nominal depth
 // (the point of the centroid's line of sight nearest the nominal position);
-// a grid of hypotheses there — rz over one symmetry period, five tilts, four
-// joint values within what the stimulus allows — is scored in batches, and
-// the best few seed one PSO each with wide spreads. The best result wins.
+// a grid of hypotheses there — rz over one symmetry period, five tilts (13
+// with [tracker] coarse_wide_tilts), four joint values within what the
+// stimulus allows — is scored in batches, and the best few seed one PSO each
+// with wide spreads. The best result wins.
 #pragma once
 
 #include <Eigen/Core>

@@ -49,7 +49,8 @@ struct Tracker::Impl {
   static constexpr double kCompleteRatio = 0.9;
   // Below this tilt (deg) a result and its mirror are the same configuration.
   static constexpr double kMirrorMinTiltDeg = 3.0;
-  // Re-detection replaces the track when its cost is below this share of the track's.
+  // Re-detection replaces the track when its cost is below this share of the
+  // track's, times the share of the model observed (a larger gain under occlusion).
   static constexpr double kRedetectGain = 0.7;
   // Spread multiplier of the re-detection's local swarm.
   static constexpr double kWideSpread = 3.0;
@@ -156,10 +157,7 @@ struct Tracker::Impl {
     }
     cost->set_outside_weight(outside_weight);
     set_allowance(searching ? 0 : previous_area);
-    // Share of the model at the previous estimate that is observed now.
-    const double visible =
-        previous_area > observation.count ? static_cast<double>(observation.count) / static_cast<double>(previous_area)
-                                          : 1.0;
+    double visible = visible_share(previous_area);
     e.outside_allowance = cost->outside_allowance();
     e.outside_weight = cost->outside_weight();
     e.observed_pixels = observation.count;
@@ -207,9 +205,14 @@ struct Tracker::Impl {
             observation = whole;
             renderer->set_observation(observation.mask);
             set_allowance(previous_area);
+            visible = visible_share(previous_area);
             current = cost->evaluate_one(best);
             ++bookkeeping;
           }
+          // The searches run without the temporal term, which would hold
+          // them near the configuration they are to question.
+          const bool predicting = prediction && config.cost.temporal > 0;
+          if (predicting) cost->clear_prediction();
           auto found = coarse(stimulus_on, rng);
           {
             const PsoResult wide = optimise_with(config.pso, best, stimulus_on, rng, nullptr, kWideSpread);
@@ -217,6 +220,9 @@ struct Tracker::Impl {
               found.best = wide.best;
               found.cost = wide.best_cost;
             }
+          }
+          if (predicting) {
+            cost->set_prediction(*prediction, spread(), config.space.periodic.size() > 5 && config.space.periodic[5]);
           }
           const CostTerms alternative = cost->evaluate_one(found.best);
           ++bookkeeping;
@@ -235,6 +241,7 @@ struct Tracker::Impl {
             observation = trimmed;
             renderer->set_observation(observation.mask);
             set_allowance(previous_area);
+            visible = visible_share(previous_area);
           }
         }
       }
@@ -252,12 +259,15 @@ struct Tracker::Impl {
         PsoConfig small = config.pso;
         small.particles = std::max(4, config.pso.particles / 2);
         small.generations = std::max(2, config.pso.generations / 2);
+        // (Its own mirror particles start back on the first branch: a
+        // second, short look at both.)
         const PsoResult m = optimise_with(small, mirror, stimulus_on, rng);
         const double current = cost->evaluate_one(best).total;
         ++bookkeeping;
         if (m.best_cost < current) {
+          // Reported as mirrored only when the tilt did change branch.
+          e.mirrored = m.best[3] * best[3] + m.best[4] * best[4] < 0;
           best = m.best;
-          e.mirrored = true;
         }
       }
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
@@ -272,7 +282,9 @@ struct Tracker::Impl {
         e.hypothesis = best;
       } else {
         lost = 0;
-        if (e.status == TrackStatus::Tracked && last) {
+        // A velocity needs two estimates of one continuous track: not across
+        // a search, a re-detection or a switch to the mirror branch.
+        if (e.status == TrackStatus::Tracked && last && !e.redetected && !e.mirrored) {
           before_last = last;
         } else {
           before_last.reset();
@@ -285,6 +297,13 @@ struct Tracker::Impl {
     e.times.pso_ms = ms_since(t1);
     e.ms = ms_since(t0);
     return e;
+  }
+
+  // Share of the model at the previous estimate that is observed now.
+  double visible_share(std::uint64_t previous_area) const {
+    return previous_area > observation.count
+               ? static_cast<double>(observation.count) / static_cast<double>(previous_area)
+               : 1.0;
   }
 
   // The occlusion budget for the current observation against the model's
