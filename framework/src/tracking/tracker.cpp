@@ -174,20 +174,29 @@ struct Tracker::Impl {
     } else {
       renderer->set_observation(observation.mask);
       const std::uint64_t evals0 = cost->evaluations();
-      std::uint64_t bookkeeping = 0;  // single scores of a result, not the search's
+      // Single scores of a result (not the search's evaluations): `terms` is
+      // always the score of `best` on the current observation.
+      std::uint64_t bookkeeping = 0;
+      const auto score = [&](const Eigen::VectorXd& h) {
+        ++bookkeeping;
+        return cost->evaluate_one(h);
+      };
       Eigen::VectorXd best;
+      CostTerms terms;
       if (searching && !started && config.tracker.initial_pose) {
         best = optimise(*config.tracker.initial_pose, stimulus_on, rng);
         e.status = TrackStatus::Tracked;
+        terms = score(best);
       } else if (searching) {
         best = coarse(stimulus_on, rng).best;
         e.status = TrackStatus::Search;
         reference_area = 0;
+        terms = score(best);
       } else {
         best = optimise(*last, stimulus_on, rng, prediction ? &*prediction : nullptr);
         e.status = TrackStatus::Tracked;
-        const CostTerms tracked = cost->evaluate_one(best);
-        ++bookkeeping;
+        const CostTerms tracked = score(best);
+        terms = tracked;
         if (tracked.dice > config.tracker.redetect_dice) {
           // Re-detection: the coarse search, and a swarm around the track
           // with three times the spreads (the right configuration is often a
@@ -206,8 +215,7 @@ struct Tracker::Impl {
             renderer->set_observation(observation.mask);
             set_allowance(previous_area);
             visible = visible_share(previous_area);
-            current = cost->evaluate_one(best);
-            ++bookkeeping;
+            current = score(best);
           }
           // The searches run without the temporal term, which would hold
           // them near the configuration they are to question.
@@ -224,8 +232,7 @@ struct Tracker::Impl {
           if (predicting) {
             cost->set_prediction(*prediction, spread(), config.space.periodic.size() > 5 && config.space.periodic[5]);
           }
-          const CostTerms alternative = cost->evaluate_one(found.best);
-          ++bookkeeping;
+          const CostTerms alternative = score(found.best);
           const double lt = config.cost.temporal;
           // Compared without the temporal term: the point is to leave the
           // predicted configuration when the image says it is wrong. And
@@ -236,12 +243,12 @@ struct Tracker::Impl {
           if (alternative.total - lt * alternative.temporal <
               kRedetectGain * visible * (current.total - lt * current.temporal)) {
             best = found.best;
+            terms = alternative;
             e.redetected = true;
           } else if (widened) {
             observation = trimmed;
             renderer->set_observation(observation.mask);
             set_allowance(previous_area);
-            visible = visible_share(previous_area);
           }
         }
       }
@@ -262,18 +269,17 @@ struct Tracker::Impl {
         // (Its own mirror particles start back on the first branch: a
         // second, short look at both.)
         const PsoResult m = optimise_with(small, mirror, stimulus_on, rng);
-        const double current = cost->evaluate_one(best).total;
-        ++bookkeeping;
-        if (m.best_cost < current) {
+        if (m.best_cost < terms.total) {
           // Reported as mirrored only when the tilt did change branch.
           e.mirrored = m.best[3] * best[3] + m.best[4] * best[4] < 0;
           best = m.best;
+          terms = score(best);
         }
       }
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
       e.outside_allowance = cost->outside_allowance();  // re-detection may have widened O
       e.observed_pixels = observation.count;
-      e.terms = cost->evaluate_one(best);
+      e.terms = terms;
       if (e.terms.dice > config.tracker.lost_dice) {
         ++lost;
         e.status = TrackStatus::Lost;
