@@ -135,6 +135,19 @@ TEST(Tracker, FollowsAMovingFoldingGripper) {
   }
 }
 
+// A half-covered gripper image: the part left of the model's projected
+// centre hidden behind background grey.
+cv::Mat half_covered(gtrack::Tracker& tracker, const gtrack::Setup& setup, const Eigen::VectorXd& truth,
+                     std::uint64_t seed) {
+  cv::Mat img = scene(setup, truth, seed);
+  const cv::Mat mask = tracker.renderer().render_mask(truth);
+  const cv::Moments m = cv::moments(mask, true);
+  EXPECT_GT(m.m00, 0) << "the model is not in view";
+  const int cx = m.m00 > 0 ? static_cast<int>(m.m10 / m.m00 * img.cols / mask.cols) : img.cols / 2;
+  img(cv::Rect(0, 0, cx, img.rows)).setTo(cv::Scalar(120, 125, 130));
+  return img;
+}
+
 // [cost] occlusion_discount: when half of the gripper disappears behind a
 // grey occluder, rendered pixels outside O are down-weighted (w < 1) and the
 // track holds where the paper's D would shrink the model onto what is left.
@@ -150,14 +163,7 @@ TEST(Tracker, OcclusionDiscountsRenderedPixelsOutsideO) {
   const auto clean = tracker.process(scene(setup, truth, 1), 0, 0.0, 22.0);
   EXPECT_DOUBLE_EQ(clean.outside_weight, 1.0);
   for (int i = 1; i < 4; ++i) {
-    cv::Mat img = scene(setup, truth, i + 1);
-    // Cover the half of the gripper left of its projected centre.
-    const cv::Mat mask = tracker.renderer().render_mask(truth);
-    const cv::Moments m = cv::moments(mask, true);
-    ASSERT_GT(m.m00, 0);
-    const int cx = static_cast<int>(m.m10 / m.m00 * img.cols / mask.cols);
-    img(cv::Rect(0, 0, cx, img.rows)).setTo(cv::Scalar(120, 125, 130));
-    const auto e = tracker.process(img, i, i / 30.0, 22.0);
+    const auto e = tracker.process(half_covered(tracker, setup, truth, i + 1), i, i / 30.0, 22.0);
     EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
     EXPECT_LT(e.outside_weight, 0.8) << "frame " << i;
     EXPECT_GT(e.outside_weight, 0.2) << "frame " << i;
@@ -339,18 +345,6 @@ TEST(TrackSequence, BadInputsAreInputErrors) {
   opt.input = (seq / "frames").string();
   opt.out_dir = dir / "file" / "out";
   EXPECT_THROW(gtrack::track_sequence(setup, config, opt), gtrack::InputError);
-}
-
-// A half-covered gripper image, the left half of its projected centre hidden
-// behind background grey.
-cv::Mat half_covered(gtrack::Tracker& tracker, const gtrack::Setup& setup, const Eigen::VectorXd& truth,
-                     std::uint64_t seed) {
-  cv::Mat img = scene(setup, truth, seed);
-  const cv::Mat mask = tracker.renderer().render_mask(truth);
-  const cv::Moments m = cv::moments(mask, true);
-  const int cx = m.m00 > 0 ? static_cast<int>(m.m10 / m.m00 * img.cols / mask.cols) : img.cols / 2;
-  img(cv::Rect(0, 0, cx, img.rows)).setTo(cv::Scalar(120, 125, 130));
-  return img;
 }
 
 // [cost] occlusion_budget (on by default): the area the observation lacks
