@@ -32,27 +32,8 @@ base_frames=60
 rm -rf "$work"
 mkdir -p "$work/frames"
 
-cat >"$work/small.toml" <<'EOF'
-# 128x128 microscope: a 4 mm gripper ~64 px across, rendered at 32x32.
-[sensor]
-plugin = "pinhole_microscope"
-width = 128
-height = 128
-fx = 1600.0
-fy = 1600.0
-cx = 63.5
-cy = 63.5
-working_distance_mm = 100.0
-[gripper]
-plugin = "hydrogel_six_finger"
-[stimulus]
-plugin = "temperature_hysteresis"
-mode = "reversible"
-unfold_below_C = 24.0
-fold_above_C = 27.0
-[render]
-backend = "cpu"
-EOF
+# The small setup the fault tests use too, on the cpu backend.
+{ cat tests/data/microscope_128.toml; printf '[render]\nbackend = "cpu"\n'; } >"$work/small.toml"
 "$bin" synth --config "$work/small.toml" --out "$work/seq" --frames "$base_frames" --seed 3 >/dev/null
 
 # Frame i of the soak is frame pingpong(i) of the sequence.

@@ -34,24 +34,15 @@ namespace {
 constexpr int kSide = 128;
 constexpr int kFrames = 8;
 
-// A 4 mm gripper about 64 px across in a 128x128 image; tiny swarm.
-const std::string kConfig = R"(
-[sensor]
-plugin = "pinhole_microscope"
-width = 128
-height = 128
-fx = 1600.0
-fy = 1600.0
-cx = 63.5
-cy = 63.5
-working_distance_mm = 100.0
-[gripper]
-plugin = "hydrogel_six_finger"
-[stimulus]
-plugin = "temperature_hysteresis"
-mode = "reversible"
-unfold_below_C = 24.0
-fold_above_C = 27.0
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// tests/data/microscope_128.toml (shared with scripts/soak.sh) and a tiny swarm.
+const std::string kConfig = read_text(fs::path(GTRACK_TEST_SOURCE_DIR) / "tests" / "data" / "microscope_128.toml") + R"(
 [pso]
 particles = 8
 generations = 2
