@@ -52,17 +52,19 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.range.every = every;
   opt.save_masks = vm.count("save-masks") > 0;
   if (vm.count("no-overlay")) opt.overlay = false;
+  opt.resume = vm.count("resume") > 0;
   opt.cancel = &g_stop;
   install_sigint();
 
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
   if (s.cancelled) {
     std::cerr << "gtrack track: interrupted; " << s.frames << " finished frames kept in " << opt.out_dir.string()
-              << "\n";
+              << " (the same command with --resume continues)\n";
   }
   std::printf("%d frames (%d lost), mean cost %.4f, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
               s.frames, s.lost_frames, s.mean_cost, s.mean_ms, s.mean_times.segment_ms, s.mean_times.pso_ms,
               s.mean_times.io_ms, s.renderer.c_str(), opt.out_dir.string().c_str());
+  if (s.resumed_after >= 0) std::printf("resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
   return s.cancelled ? 130 : 0;
 }
 
@@ -79,6 +81,7 @@ GTRACK_COMMAND(
           "every", po::value<int>()->default_value(1), "track every K-th frame")(
           "frames", po::value<std::string>(), "A:B, frames A (inclusive) to B (exclusive)")(
           "save-masks", "write each observation O to OUT/masks/NNNNNN.png")(
-          "no-overlay", "do not write the overlay video");
+          "no-overlay", "do not write the overlay video")(
+          "resume", "continue the run whose files are in OUT after its last finished frame");
     },
     run_track)

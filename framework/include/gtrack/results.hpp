@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "gtrack/export.hpp"
 #include "gtrack/tracker.hpp"
@@ -19,7 +20,8 @@ namespace gtrack {
 class GTRACK_API ResultWriter {
  public:
   // Creates the folder if needed; InputError if it cannot be written.
-  ResultWriter(const std::filesystem::path& out_dir, int fingers);
+  // append: continue the files already there (after resume_results).
+  ResultWriter(const std::filesystem::path& out_dir, int fingers, bool append = false);
   void write(const Estimate& estimate);
   void close();
 
@@ -29,5 +31,12 @@ class GTRACK_API ResultWriter {
 };
 
 GTRACK_API void write_summary(const std::filesystem::path& file, const TrackSummary& summary);
+
+// Prepares out_dir for a resumed run: keeps the rows of estimates.csv and
+// estimates.jsonl up to frame `last` (a row cut short by an interruption, or
+// written after the state was, is dropped) and returns the frame indices
+// kept, in order. InputError when estimates.csv is missing or was written
+// for another number of fingers.
+GTRACK_API std::vector<int> resume_results(const std::filesystem::path& out_dir, int fingers, int last);
 
 }  // namespace gtrack

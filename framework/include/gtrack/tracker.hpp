@@ -44,6 +44,7 @@
 #include "gtrack/pso.hpp"
 #include "gtrack/renderer.hpp"
 #include "gtrack/setup.hpp"
+#include "gtrack/tracker_state.hpp"
 
 namespace gtrack {
 
@@ -98,6 +99,12 @@ class GTRACK_API Tracker {
 
   // Forget the history: the next frame starts like the first.
   void reset();
+  TrackerState state() const;
+  // Continue from a state (of a tracker with the same setup and config).
+  void restore(const TrackerState& state);
+  // Feeds a past frame's reading to the stimulus plugin as process() would,
+  // without tracking: replayed in order, it rebuilds the plugin's state.
+  void replay_stimulus(std::optional<double> stimulus, double time_s);
   // Start the next frame from this hypothesis (as if it were the last estimate).
   void set_estimate(const Eigen::VectorXd& hypothesis);
   const std::optional<Eigen::VectorXd>& last_estimate() const;
@@ -127,6 +134,9 @@ struct TrackOptions {
   std::optional<bool> overlay;                // overrides [tracker] overlay
   bool progress = true;                       // progress line on stderr
   const std::atomic<bool>* cancel = nullptr;  // raised: finish the frame, close files, return
+  // Continue the run whose files are in out_dir, after the last frame its
+  // tracker_state.txt records (none there: start from the first frame).
+  bool resume = false;
   std::function<void(const Estimate&)> on_frame;  // called after each frame is written
 };
 
@@ -140,6 +150,8 @@ struct TrackSummary {
   bool cancelled = false;
   std::string renderer;
   std::filesystem::path overlay_file;  // empty if none was written
+  int resumed_after = -1;    // --resume: the last frame done before this run (-1: a fresh run)
+  int frames_before = 0;     // --resume: rows kept from before; `frames` counts this run's only
 };
 
 // Runs the tracker over a source and writes, in options.out_dir:

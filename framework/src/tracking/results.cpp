@@ -1,8 +1,11 @@
 // estimates.csv / estimates.jsonl rows and summary.json.
 #include "gtrack/results.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 
 #include "gtrack/error.hpp"
 
@@ -19,26 +22,65 @@ std::string num(double v, const char* fmt) {
   return buf;
 }
 
-std::ofstream open_truncated(const fs::path& p) {
-  std::ofstream out(p, std::ios::trunc);
+std::ofstream open_for_writing(const fs::path& p, bool append) {
+  std::ofstream out(p, append ? std::ios::app : std::ios::trunc);
   if (!out) throw InputError(p.string() + ": cannot open for writing");
   return out;
 }
 
+std::string csv_header(int fingers) {
+  std::string h = "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg";
+  for (int f = 1; f <= fingers; ++f) h += ",q" + std::to_string(f) + "_deg";
+  return h + ",cost,status,ms";
+}
+
+// Whole lines only: a last line without its newline was cut short.
+std::vector<std::string> complete_lines(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (size_t nl; (nl = text.find('\n', start)) != std::string::npos; start = nl + 1) {
+    lines.push_back(text.substr(start, nl - start));
+  }
+  return lines;
+}
+
+// The frame index a row starts with (csv: "N,", jsonl: {"frame":N,), or -1.
+int row_frame(const std::string& line, const std::string& prefix) {
+  if (line.compare(0, prefix.size(), prefix) != 0) return -1;
+  size_t pos = prefix.size(), end = pos;
+  while (end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]))) ++end;
+  if (end == pos || end - pos > 9 || end >= line.size() || line[end] != ',') return -1;
+  return std::stoi(line.substr(pos, end - pos));
+}
+
+// Replaces a file by its lines, through a temporary file and a rename.
+void rewrite(const fs::path& p, const std::vector<std::string>& lines) {
+  const fs::path tmp = p.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc | std::ios::binary);
+    for (const auto& l : lines) out << l << '\n';
+    out.flush();
+    if (!out) throw InputError(tmp.string() + ": write failed");
+  }
+  std::error_code ec;
+  fs::rename(tmp, p, ec);
+  if (ec) throw InputError(p.string() + ": cannot replace (" + ec.message() + ")");
+}
+
 }  // namespace
 
-ResultWriter::ResultWriter(const fs::path& out_dir, int fingers) : dir_(out_dir) {
+ResultWriter::ResultWriter(const fs::path& out_dir, int fingers, bool append) : dir_(out_dir) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir)) {
     throw InputError(out_dir.string() + ": cannot create the output folder (" +
                      (ec ? ec.message() : std::string("not a folder")) + ")");
   }
-  csv_ = open_truncated(out_dir / "estimates.csv");
-  jsonl_ = open_truncated(out_dir / "estimates.jsonl");
-  csv_ << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg";
-  for (int f = 1; f <= fingers; ++f) csv_ << ",q" << f << "_deg";
-  csv_ << ",cost,status,ms\n";
+  csv_ = open_for_writing(out_dir / "estimates.csv", append);
+  jsonl_ = open_for_writing(out_dir / "estimates.jsonl", append);
+  if (!append) csv_ << csv_header(fingers) << '\n';
   csv_.flush();
   if (!csv_) throw InputError((out_dir / "estimates.csv").string() + ": write failed");
 }
@@ -94,9 +136,44 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
       << "  \"frames_per_s\": " << num(fps, "%.3f") << ",\n"
       << "  \"renderer\": \"" << s.renderer << "\",\n"
       << "  \"overlay\": \"" << s.overlay_file.filename().string() << "\",\n"
+      << "  \"resumed_after_frame\": " << (s.resumed_after >= 0 ? std::to_string(s.resumed_after) : "null") << ",\n"
+      << "  \"frames_before_resume\": " << s.frames_before << ",\n"
       << "  \"cancelled\": " << (s.cancelled ? "true" : "false") << "\n"
       << "}\n";
   if (!out) throw InputError(file.string() + ": write failed");
+}
+
+std::vector<int> resume_results(const fs::path& out_dir, int fingers, int last) {
+  const fs::path csv = out_dir / "estimates.csv", jsonl = out_dir / "estimates.jsonl";
+  if (!fs::exists(csv)) throw InputError(csv.string() + ": missing; there is nothing to resume");
+  auto rows = complete_lines(csv);
+  if (rows.empty() || rows[0] != csv_header(fingers)) {
+    throw InputError(csv.string() + ":1: expected the header '" + csv_header(fingers) +
+                     "' (a gripper with " + std::to_string(fingers) + " fingers); cannot resume");
+  }
+  std::vector<std::string> kept{rows[0]};
+  std::vector<int> frames;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const int f = row_frame(rows[i], "");
+    if (f < 0 || f > last) break;
+    kept.push_back(rows[i]);
+    frames.push_back(f);
+  }
+  if (frames.empty() || frames.back() != last) {
+    throw InputError(csv.string() + ": its rows end at frame " + (frames.empty() ? std::string("(none)") : std::to_string(frames.back())) +
+                     ", the tracker state at frame " + std::to_string(last) + "; cannot resume");
+  }
+  rewrite(csv, kept);
+  std::vector<std::string> jkept;
+  if (fs::exists(jsonl)) {
+    for (const auto& l : complete_lines(jsonl)) {
+      const int f = row_frame(l, "{\"frame\":");
+      if (f < 0 || f > last) break;
+      jkept.push_back(l);
+    }
+  }
+  rewrite(jsonl, jkept);
+  return frames;
 }
 
 }  // namespace gtrack

@@ -26,7 +26,8 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 // mp4 where the OpenCV build can write it, MJPG in AVI everywhere else.
 class OverlayWriter {
  public:
-  OverlayWriter(fs::path dir, double fps) : dir_(std::move(dir)), fps_(fps > 0 ? fps : 30) {}
+  OverlayWriter(fs::path dir, double fps, std::string stem)
+      : dir_(std::move(dir)), fps_(fps > 0 ? fps : 30), stem_(std::move(stem)) {}
   void write(const cv::Mat& img) {
     if (!writer_.isOpened() && !failed_) open(img.size());
     if (writer_.isOpened()) writer_.write(img);
@@ -36,7 +37,7 @@ class OverlayWriter {
 
  private:
   void open(cv::Size size) {
-    const fs::path mp4 = dir_ / "overlay.mp4";
+    const fs::path mp4 = dir_ / (stem_ + ".mp4");
     for (const char* cc : {"avc1", "mp4v"}) {
       if (writer_.open(mp4.string(), cv::VideoWriter::fourcc(cc[0], cc[1], cc[2], cc[3]), fps_, size)) {
         file_ = mp4;
@@ -45,7 +46,7 @@ class OverlayWriter {
     }
     std::error_code ec;
     fs::remove(mp4, ec);
-    const fs::path avi = dir_ / "overlay.avi";
+    const fs::path avi = dir_ / (stem_ + ".avi");
     if (writer_.open(avi.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_, size)) {
       file_ = avi;
       return;
@@ -55,6 +56,7 @@ class OverlayWriter {
   }
   fs::path dir_;
   double fps_;
+  std::string stem_;
   cv::VideoWriter writer_;
   fs::path file_;
   bool failed_ = false;
@@ -115,20 +117,70 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // Inputs are checked before anything is written.
   std::optional<StimulusLog> log;
   if (options.stimulus_csv) log = StimulusLog::load(*options.stimulus_csv);
-  auto source = open_frame_source(options.input, setup.sensor->image_size(), options.range,
+  // Resuming: the saved state says which frame was done last; the source
+  // starts at the next frame of the range.
+  const fs::path state_file = options.out_dir / "tracker_state.txt";
+  std::optional<TrackerState> resumed;
+  FrameRange range = options.range;
+  if (options.resume && options.input.rfind("camera:", 0) == 0) {
+    throw InputError("--resume continues a video or a folder of images, not a live camera (" + options.input + ")");
+  }
+  if (options.resume && fs::exists(state_file)) {
+    resumed = read_tracker_state(state_file);
+    for (const auto* v : {&resumed->last, &resumed->before_last}) {
+      if (*v && (*v)->size() != config.space.dims()) {
+        throw InputError(state_file.string() + ": holds a configuration of " + std::to_string((*v)->size()) +
+                         " values, this setup has " + std::to_string(config.space.dims()) + "; cannot resume");
+      }
+    }
+    const int every = std::max(1, range.every);
+    if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
+  } else if (options.resume) {
+    logger().info("{}: no tracker state to resume from; starting from the first frame", state_file.string());
+  }
+  auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
                                   config.tracker.fps > 0 ? config.tracker.fps : 30.0);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
 
-  ResultWriter results(options.out_dir, setup.model().fingers());
+  // The reading of a frame: the log's, or its nearest past the log's ends.
+  bool warned_range = false;
+  const auto reading_at = [&](int index, double time_s) -> std::optional<double> {
+    if (!log) return std::nullopt;
+    std::optional<double> reading = log->value_at(index, time_s);
+    if (!reading) {
+      if (!warned_range) {
+        logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log; holding its nearest reading",
+                      log->source(), index, time_s);
+        warned_range = true;
+      }
+      reading = log->nearest(index, time_s);
+    }
+    return reading;
+  };
+
+  // The files are cut back to the frame the saved state records.
+  std::vector<int> done;
+  if (resumed) done = resume_results(options.out_dir, setup.model().fingers(), resumed->frame);
+  ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
   if (options.save_masks) {
     std::error_code ec;
     fs::create_directories(options.out_dir / "masks", ec);
     if (ec) throw InputError((options.out_dir / "masks").string() + ": cannot create (" + ec.message() + ")");
   }
   Tracker tracker(setup, config);
+  if (resumed) {
+    // The stimulus plugin's state is rebuilt by replaying the readings of
+    // the frames already done, in order.
+    for (const int index : done) tracker.replay_stimulus(reading_at(index, index / fps), index / fps);
+    tracker.restore(*resumed);
+    logger().info("resuming after frame {} ({} frames already in {})", resumed->frame, done.size(),
+                  options.out_dir.string());
+  }
   const bool want_overlay = options.overlay.value_or(config.tracker.overlay);
-  OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every));
-  Progress progress(options.progress, expected_frames(*source, options.range), config.tracker.progress_every);
+  char overlay_stem[48] = "overlay";
+  if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", resumed->frame + 1);
+  OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem);
+  Progress progress(options.progress, expected_frames(*source, range), config.tracker.progress_every);
 
   if (!log && !config.tracker.default_stimulus) {
     logger().info("no stimulus log and no [tracker] default_stimulus: S(H) and the biased initialisation are off");
@@ -142,9 +194,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
 
   TrackSummary summary;
   summary.renderer = tracker.renderer().name();
+  if (resumed) {
+    summary.resumed_after = resumed->frame;
+    summary.frames_before = static_cast<int>(done.size());
+  }
   double cost_sum = 0, ms_sum = 0;
   StageTimes sums;
-  bool warned_range = false;
   for (;;) {
     if (options.cancel && options.cancel->load()) {
       summary.cancelled = true;
@@ -155,19 +210,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (!frame) break;
     double io_ms = seconds_since(t_read) * 1e3;
     const double time_s = frame->index / fps;
-
-    std::optional<double> reading;
-    if (log) {
-      reading = log->value_at(frame->index, time_s);
-      if (!reading) {
-        if (!warned_range) {
-          logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log; holding its nearest reading",
-                        log->source(), frame->index, time_s);
-          warned_range = true;
-        }
-        reading = log->nearest(frame->index, time_s);
-      }
-    }
+    const std::optional<double> reading = reading_at(frame->index, time_s);
 
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
 
@@ -182,6 +225,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     io_ms += seconds_since(t_write) * 1e3;
     e.times.io_ms = io_ms;
     results.write(e);
+    write_tracker_state(state_file, tracker.state());
     if (options.on_frame) options.on_frame(e);
 
     ++summary.frames;

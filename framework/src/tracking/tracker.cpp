@@ -55,6 +55,7 @@ struct Tracker::Impl {
   // Spread multiplier of the re-detection's local swarm.
   static constexpr double kWideSpread = 3.0;
   bool started = false;  // a frame has been processed since construction or reset
+  int last_frame = -1;   // the last frame processed
   int lost = 0;          // consecutive lost frames
   Observation observation;
 
@@ -112,10 +113,10 @@ struct Tracker::Impl {
     e.frame = index;
     e.time_s = time_s;
     std::mt19937_64 rng(frame_seed(config.pso.seed, index));
+    last_frame = index;
 
-    if (!reading && config.tracker.default_stimulus) reading = config.tracker.default_stimulus;
+    reading = feed_stimulus(reading, time_s);
     const bool stimulus_on = reading.has_value() && setup.stimulus != nullptr;
-    if (stimulus_on) setup.stimulus->update(*reading, time_s);
     e.stimulus = reading;
     cost->set_stimulus(stimulus_on ? setup.stimulus.get() : nullptr);
 
@@ -305,6 +306,14 @@ struct Tracker::Impl {
     return e;
   }
 
+  // The reading in force for a frame (the configured default when there is
+  // none), fed to the stimulus plugin.
+  std::optional<double> feed_stimulus(std::optional<double> reading, double time_s) {
+    if (!reading && config.tracker.default_stimulus) reading = config.tracker.default_stimulus;
+    if (reading && setup.stimulus) setup.stimulus->update(*reading, time_s);
+    return reading;
+  }
+
   // Share of the model at the previous estimate that is observed now.
   double visible_share(std::uint64_t previous_area) const {
     return previous_area > observation.count
@@ -402,7 +411,39 @@ void Tracker::reset() {
   impl_->before_last.reset();
   impl_->reference_area = 0;
   impl_->started = false;
+  impl_->last_frame = -1;
   impl_->lost = 0;
+}
+
+TrackerState Tracker::state() const {
+  TrackerState s;
+  s.frame = impl_->last_frame;
+  s.last = impl_->last;
+  s.before_last = impl_->before_last;
+  s.lost = impl_->lost;
+  s.started = impl_->started;
+  s.reference_area = impl_->reference_area;
+  return s;
+}
+
+void Tracker::restore(const TrackerState& s) {
+  const int dims = impl_->config.space.dims();
+  for (const auto* h : {&s.last, &s.before_last}) {
+    if (*h && (*h)->size() != dims) {
+      throw Error("tracker state: a configuration of " + std::to_string((*h)->size()) + " values, expected " +
+                  std::to_string(dims));
+    }
+  }
+  impl_->last_frame = s.frame;
+  impl_->last = s.last;
+  impl_->before_last = s.before_last;
+  impl_->lost = s.lost;
+  impl_->started = s.started;
+  impl_->reference_area = s.reference_area;
+}
+
+void Tracker::replay_stimulus(std::optional<double> stimulus, double time_s) {
+  impl_->feed_stimulus(stimulus, time_s);
 }
 
 void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {

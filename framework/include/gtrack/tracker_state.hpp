@@ -1,0 +1,43 @@
+// What the tracker carries from one frame to the next, and its file,
+// tracker_state.txt (`gtrack track --resume`, docs/tracker.md).
+//
+//   gtrack-tracker-state 1
+//   frame 41
+//   lost 0
+//   started 1
+//   reference_area 0
+//   last 0.28088680263448867 -0.65538763658777754 100.09506213033944 ...
+//   before_last -
+//
+// The configurations are written with 17 significant digits, so a resumed
+// run starts from exactly the values the interrupted one held.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "gtrack/export.hpp"
+
+namespace gtrack {
+
+// With the stimulus plugin's state (rebuilt by replaying the past readings)
+// it is all a run needs to continue where it stopped, with the same results.
+struct TrackerState {
+  int frame = -1;  // the last frame processed; -1 = none
+  std::optional<Eigen::VectorXd> last, before_last;
+  int lost = 0;
+  bool started = false;
+  std::uint64_t reference_area = 0;
+};
+
+// Replaces `file` (write, then rename): never a half-written state.
+GTRACK_API void write_tracker_state(const std::filesystem::path& file, const TrackerState& state);
+// InputError "name:line: ..." when the text is not a tracker state.
+GTRACK_API TrackerState parse_tracker_state(std::string_view text, const std::string& name);
+GTRACK_API TrackerState read_tracker_state(const std::filesystem::path& file);
+
+}  // namespace gtrack

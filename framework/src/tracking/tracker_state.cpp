@@ -1,0 +1,138 @@
+// tracker_state.txt: writing it after every frame, reading it to resume.
+#include "gtrack/tracker_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "gtrack/error.hpp"
+
+namespace gtrack {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void write_vector(std::ostream& out, const char* name, const std::optional<Eigen::VectorXd>& v) {
+  out << name;
+  if (!v) {
+    out << " -\n";
+    return;
+  }
+  char buf[32];
+  for (Eigen::Index i = 0; i < v->size(); ++i) {
+    std::snprintf(buf, sizeof buf, " %.17g", (*v)[i]);
+    out << buf;
+  }
+  out << '\n';
+}
+
+}  // namespace
+
+void write_tracker_state(const fs::path& file, const TrackerState& s) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << "gtrack-tracker-state 1\n"
+        << "frame " << s.frame << "\n"
+        << "lost " << s.lost << "\n"
+        << "started " << (s.started ? 1 : 0) << "\n"
+        << "reference_area " << s.reference_area << "\n";
+    write_vector(out, "last", s.last);
+    write_vector(out, "before_last", s.before_last);
+    out.flush();
+    if (!out) throw InputError(tmp.string() + ": write failed");
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) throw InputError(file.string() + ": cannot replace (" + ec.message() + ")");
+}
+
+TrackerState parse_tracker_state(std::string_view text, const std::string& name) {
+  std::istringstream in{std::string(text)};
+  TrackerState s;
+  std::string line;
+  int n = 0;
+  const auto fail = [&](const std::string& what) {
+    throw InputError(name + ":" + std::to_string(n) + ": " + what);
+  };
+  bool header = false, have_frame = false;
+  while (std::getline(in, line)) {
+    ++n;
+    std::istringstream ls(line);
+    std::string key;
+    ls >> key;
+    if (n == 1) {
+      int version = 0;
+      if (key != "gtrack-tracker-state" || !(ls >> version) || version != 1) {
+        fail("expected 'gtrack-tracker-state 1', the header of a tracker state");
+      }
+      header = true;
+      continue;
+    }
+    if (key == "last" || key == "before_last") {
+      std::vector<double> v;
+      std::string tok;
+      bool none = false;
+      while (ls >> tok) {
+        if (tok == "-") {
+          none = true;
+          continue;
+        }
+        char* end = nullptr;
+        const double x = std::strtod(tok.c_str(), &end);
+        if (end == tok.c_str() || *end != '\0' || !std::isfinite(x)) fail("'" + tok + "' is not a finite number");
+        v.push_back(x);
+      }
+      if (none != v.empty()) fail("expected '-' or the values of a configuration after '" + key + "'");
+      if (!none) (key == "last" ? s.last : s.before_last) = Eigen::Map<Eigen::VectorXd>(v.data(), v.size());
+      continue;
+    }
+    long long value = 0;
+    std::string rest;
+    if (!(ls >> value) || (ls >> rest)) fail("expected one integer after '" + key + "'");
+    const auto within = [&](long long lo, long long hi) {
+      if (value < lo || value > hi) {
+        fail("'" + key + "' must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+             std::to_string(value));
+      }
+    };
+    constexpr long long kMaxInt = std::numeric_limits<int>::max();
+    if (key == "frame") {
+      within(-1, kMaxInt);
+      s.frame = static_cast<int>(value);
+      have_frame = true;
+    } else if (key == "lost") {
+      within(0, kMaxInt);
+      s.lost = static_cast<int>(value);
+    } else if (key == "started") {
+      within(0, 1);
+      s.started = value != 0;
+    } else if (key == "reference_area") {
+      within(0, std::numeric_limits<long long>::max());
+      s.reference_area = static_cast<std::uint64_t>(value);
+    } else {
+      fail("unknown key '" + key + "'");
+    }
+  }
+  if (!header || !have_frame) {
+    n = std::max(n, 1);
+    fail("incomplete tracker state (no header or no frame line)");
+  }
+  return s;
+}
+
+TrackerState read_tracker_state(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_tracker_state(text, file.string());
+}
+
+}  // namespace gtrack
