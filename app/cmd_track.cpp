@@ -8,6 +8,7 @@
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/frame_source.hpp"
+#include "gtrack/results.hpp"
 #include "gtrack/setup.hpp"
 #include "gtrack/tracker.hpp"
 
@@ -53,6 +54,15 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.save_masks = vm.count("save-masks") > 0;
   if (vm.count("no-overlay")) opt.overlay = false;
   opt.resume = vm.count("resume") > 0;
+  // --stream: each estimate, as its estimates.jsonl line, on stdout as soon
+  // as it is made (for a controller reading a pipe); the rest goes to stderr.
+  const bool stream = vm.count("stream") > 0;
+  if (stream) {
+    opt.on_frame = [](const gtrack::Estimate& e) {
+      std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout);
+      std::fflush(stdout);
+    };
+  }
   opt.cancel = &g_stop;
   install_sigint();
 
@@ -61,10 +71,13 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     std::cerr << "gtrack track: interrupted; " << s.frames << " finished frames kept in " << opt.out_dir.string()
               << " (the same command with --resume continues)\n";
   }
-  std::printf("%d frames (%d lost), mean cost %.4f, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
+  std::FILE* report = stream ? stderr : stdout;
+  std::fprintf(report, "%d frames (%d lost), mean cost %.4f, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
               s.frames, s.lost_frames, s.mean_cost, s.mean_ms, s.mean_times.segment_ms, s.mean_times.pso_ms,
               s.mean_times.io_ms, s.renderer.c_str(), opt.out_dir.string().c_str());
-  if (s.resumed_after >= 0) std::printf("resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
+  if (s.resumed_after >= 0) {
+    std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
+  }
   return s.cancelled ? 130 : 0;
 }
 
@@ -82,6 +95,7 @@ GTRACK_COMMAND(
           "frames", po::value<std::string>(), "A:B, frames A (inclusive) to B (exclusive)")(
           "save-masks", "write each observation O to OUT/masks/NNNNNN.png")(
           "no-overlay", "do not write the overlay video")(
-          "resume", "continue the run whose files are in OUT after its last finished frame");
+          "resume", "continue the run whose files are in OUT after its last finished frame")(
+          "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made");
     },
     run_track)

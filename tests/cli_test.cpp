@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -16,8 +17,8 @@ struct CliRun {
   std::string output;  // stdout and stderr
 };
 
-CliRun gtrack(const std::string& args) {
-  const std::string cmd = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack " + args + " 2>&1";
+CliRun gtrack(const std::string& args, const std::string& redirect = "2>&1") {
+  const std::string cmd = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack " + args + " " + redirect;
   FILE* p = ::popen(cmd.c_str(), "r");
   std::string out;
   std::array<char, 4096> buf;
@@ -96,6 +97,24 @@ TEST(Cli, BadParameterVectorIsOneLine) {
   EXPECT_NE(r.output.find("field 3 ('abc')"), std::string::npos) << r.output;
   r = gtrack("render --config " + cfg.string() + " --params 0,0,1 --out /tmp/x.png");
   EXPECT_NE(r.output.find("got 3 values, expected 12"), std::string::npos) << r.output;
+}
+
+// --stream: stdout carries the estimates and nothing else, each line the
+// same as the one written to estimates.jsonl, so a controller can read the
+// pipe while the files are kept.
+TEST(Cli, StreamPrintsEachEstimateOnStdout) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "stream";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 2 --out " + dir.string()).code, 0);
+  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                              " -o " + (dir / "out").string() + " --no-overlay --stream",
+                          "2>/dev/null");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(dir / "out" / "estimates.jsonl");
+  std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(lines(r.output), 3) << r.output;
+  EXPECT_EQ(r.output, written);
+  EXPECT_EQ(r.output.rfind("{\"frame\":0,", 0), 0u) << r.output;
 }
 
 TEST(Cli, UsageErrors) {

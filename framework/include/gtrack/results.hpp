@@ -30,6 +30,9 @@ class GTRACK_API ResultWriter {
   std::filesystem::path dir_;
 };
 
+// One line of estimates.jsonl (without its newline).
+GTRACK_API std::string estimate_json(const Estimate& estimate);
+
 GTRACK_API void write_summary(const std::filesystem::path& file, const TrackSummary& summary);
 
 // Prepares out_dir for a resumed run: keeps the rows of estimates.csv and

@@ -93,6 +93,13 @@ void ResultWriter::write(const Estimate& e) {
   csv_ << row;
   csv_.flush();
 
+  jsonl_ << estimate_json(e) << '\n';
+  jsonl_.flush();
+  if (!csv_ || !jsonl_) throw InputError(dir_.string() + ": writing the estimates failed (disk full?)");
+}
+
+std::string estimate_json(const Estimate& e) {
+  const Eigen::VectorXd& h = e.hypothesis;
   static const char* pose[] = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
   std::string j = "{\"frame\":" + std::to_string(e.frame) + ",\"time_s\":" + num(e.time_s, "%.6f");
   for (Eigen::Index i = 0; i < h.size(); ++i) {
@@ -109,10 +116,8 @@ void ResultWriter::write(const Estimate& e) {
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);
-  j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") + "}\n";
-  jsonl_ << j;
-  jsonl_.flush();
-  if (!csv_ || !jsonl_) throw InputError(dir_.string() + ": writing the estimates failed (disk full?)");
+  j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") + "}";
+  return j;
 }
 
 void ResultWriter::close() {
