@@ -54,6 +54,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.save_masks = vm.count("save-masks") > 0;
   if (vm.count("no-overlay")) opt.overlay = false;
   opt.resume = vm.count("resume") > 0;
+  opt.follow_stimulus = vm.count("follow-stimulus") > 0;
   // --stream: each estimate, as its estimates.jsonl line, on stdout as soon
   // as it is made (for a controller reading a pipe); the rest goes to stderr.
   const bool stream = vm.count("stream") > 0;
@@ -96,6 +97,7 @@ GTRACK_COMMAND(
           "save-masks", "write each observation O to OUT/masks/NNNNNN.png")(
           "no-overlay", "do not write the overlay video")(
           "resume", "continue the run whose files are in OUT after its last finished frame")(
-          "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made");
+          "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
+          "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row");
     },
     run_track)

@@ -7,6 +7,7 @@
 // Runs are tiny (128x128 frames, N=8, G=2) so the whole file takes seconds.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <atomic>
@@ -53,8 +54,22 @@ overlay = false
 initial_pose = [0, 0, 100, 0, 0, 0, 0, 0, 0, 0, 0, 0]
 )";
 
+// Per process (two checkouts' suites may run on one machine at once), and
+// removed when the process ends.
+const fs::path& fault_root() {
+  struct Root {
+    fs::path path = fs::temp_directory_path() / ("gtrack_fault_test_" + std::to_string(::getpid()));
+    ~Root() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Root root;
+  return root.path;
+}
+
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / "gtrack_fault_test" / name;
+  const fs::path d = fault_root() / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -223,6 +238,37 @@ TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {
   for (int i = 3; i < kFrames; ++i) {
     ASSERT_TRUE(readings[i]) << "frame " << i;
     EXPECT_DOUBLE_EQ(*readings[i], 28.5) << "frame " << i;
+  }
+}
+
+// A live run follows a log that a temperature logger is still writing: each
+// frame takes the latest whole row, and a row half written waits for its end.
+TEST(Fault, FollowedStimulusLogGivesEachFrameTheLatestReading) {
+  const fs::path dir = fresh_dir("follow_stimulus");
+  const fs::path csv = dir / "stimulus.csv";
+  std::ofstream(csv) << "time_s,value\n0.0,22.0\n";
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  o.stimulus_csv = csv;
+  o.follow_stimulus = true;
+  std::vector<std::optional<double>> readings;
+  o.on_frame = [&](const gtrack::Estimate& e) {
+    readings.push_back(e.stimulus);
+    // After frame k the logger ends the row it had begun ("...5\n") and
+    // begins the next one, 23.5 + k, half written ("0.1,23.").
+    const int k = static_cast<int>(readings.size()) - 1;
+    std::ofstream(csv, std::ios::app) << (k == 0 ? "" : "5\n") << 0.1 * (k + 1) << "," << 23 + k << ".";
+  };
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  EXPECT_EQ(s.frames, kFrames);
+  ASSERT_EQ(readings.size(), static_cast<size_t>(kFrames));
+  ASSERT_TRUE(readings[0]);
+  EXPECT_DOUBLE_EQ(*readings[0], 22.0);
+  ASSERT_TRUE(readings[1]);
+  EXPECT_DOUBLE_EQ(*readings[1], 22.0);  // "0.1,23." is not a whole row yet
+  for (int i = 2; i < kFrames; ++i) {
+    ASSERT_TRUE(readings[i]) << "frame " << i;
+    EXPECT_DOUBLE_EQ(*readings[i], 23.5 + (i - 2)) << "frame " << i;
   }
 }
 

@@ -1,6 +1,9 @@
 // The stimulus CSV: both headers, interpolation, and errors with file:line.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "gtrack/error.hpp"
 #include "gtrack/stimulus_log.hpp"
 
@@ -50,3 +53,36 @@ TEST(StimulusLog, MissingFileIsAnInputError) {
 }
 
 }  // namespace
+
+// A log still being written (--follow-stimulus): poll() takes whole lines
+// as they are appended, checks them as parse() does, and latest() is the
+// last row's reading.
+TEST(StimulusLog, FollowTakesAppendedWholeLines) {
+  namespace fs = std::filesystem;
+  const fs::path file = fs::temp_directory_path() / "gtrack_stimulus_follow.csv";
+  std::ofstream(file) << "";
+  gtrack::StimulusLog log = gtrack::StimulusLog::follow(file);
+  EXPECT_FALSE(log.latest());
+  EXPECT_FALSE(log.value_at(0, 0.0));
+  const auto append = [&](const std::string& text) { std::ofstream(file, std::ios::app) << text; };
+  append("frame,value\n0,22.5\n1,2");  // the logger is half way through row 1
+  EXPECT_TRUE(log.poll());
+  ASSERT_TRUE(log.latest());
+  EXPECT_DOUBLE_EQ(*log.latest(), 22.5);
+  EXPECT_FALSE(log.poll());  // nothing whole since
+  append("3.0\n");
+  EXPECT_TRUE(log.poll());
+  EXPECT_DOUBLE_EQ(*log.latest(), 23.0);
+  EXPECT_EQ(log.rows(), 2u);
+  append("2,abc\n");
+  try {
+    log.poll();
+    FAIL() << "a malformed appended row must be refused";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("gtrack_stimulus_follow.csv:4: expected a number in the value field, got 'abc'"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ofstream(file) << "frame,value\n";
+  EXPECT_THROW(log.poll(), gtrack::InputError);  // shrank: a new log, not this one
+}

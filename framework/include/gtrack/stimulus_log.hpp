@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <ios>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,19 +25,34 @@ class GTRACK_API StimulusLog {
 
   static StimulusLog load(const std::filesystem::path& file);
   static StimulusLog parse(const std::string& text, const std::string& source = "<string>");
+  // A log still being written (a live run): poll() takes the rows appended
+  // since the last call, whole lines only, with the same checks as parse()
+  // (errors name the file and line); true when rows were added. The file may
+  // be empty, or hold only its header, at first.
+  static StimulusLog follow(const std::filesystem::path& file);
+  bool poll();
+  // The last row's reading; nullopt while there is none.
+  std::optional<double> latest() const;
 
   Key key() const { return key_; }
   // The reading for a frame (index and time); nullopt outside the log.
   std::optional<double> value_at(int frame, double time_s) const;
-  // The reading of the nearest row (for frames outside the log).
+  // The reading of the nearest row (for frames outside the log); the log
+  // must have a row.
   double nearest(int frame, double time_s) const;
   size_t rows() const { return keys_.size(); }
   const std::string& source() const { return source_; }
 
  private:
+  void take_line(std::string line);
+
   Key key_ = Key::Frame;
   std::vector<double> keys_, values_;
   std::string source_;
+  bool header_ = false;
+  int lines_ = 0;                        // lines read so far (for error messages)
+  std::filesystem::path followed_;       // follow(): the file
+  std::streamoff read_to_ = 0;           // follow(): bytes taken (whole lines)
 };
 
 }  // namespace gtrack

@@ -137,6 +137,9 @@ struct TrackOptions {
   // Continue the run whose files are in out_dir, after the last frame its
   // tracker_state.txt records (none there: start from the first frame).
   bool resume = false;
+  // The stimulus log is still being written (a live run): before each frame
+  // its new rows are read, and the frame takes the last row's reading.
+  bool follow_stimulus = false;
   std::function<void(const Estimate&)> on_frame;  // called after each frame is written
 };
 

@@ -42,48 +42,95 @@ StimulusLog StimulusLog::parse(const std::string& text, const std::string& sourc
   log.source_ = source;
   std::istringstream in(text);
   std::string line;
-  int lineno = 0;
-  bool header = false;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (lineno == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
-    const std::string t = trim(line);
-    if (t.empty() || t[0] == '#') continue;
-    const auto comma = t.find(',');
-    const std::string a = comma == std::string::npos ? t : trim(t.substr(0, comma));
-    const std::string b = comma == std::string::npos ? "" : trim(t.substr(comma + 1));
-    const std::string where = source + ":" + std::to_string(lineno) + ": ";
-    if (!header) {
-      if (comma == std::string::npos || b != "value" || (a != "frame" && a != "time_s")) {
-        throw InputError(where + "expected the header 'frame,value' or 'time_s,value', got '" + t + "'");
-      }
-      log.key_ = a == "frame" ? Key::Frame : Key::Time;
-      header = true;
-      continue;
-    }
-    const char* key_name = log.key_ == Key::Frame ? "a frame index" : "a time in seconds";
-    double k = 0, v = 0;
-    if (comma == std::string::npos || b.find(',') != std::string::npos) {
-      throw InputError(where + "expected two fields '<" + std::string(log.key_ == Key::Frame ? "frame" : "time_s") +
-                       ">,<value>', got '" + t + "'");
-    }
-    if (!parse_number(a, k) || (log.key_ == Key::Frame && (k < 0 || k != std::floor(k)))) {
-      throw InputError(where + "expected " + key_name + " in the first field, got '" + a + "'");
-    }
-    if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got '" + b + "'");
-    if (!log.keys_.empty() && !(k > log.keys_.back())) {
-      throw InputError(where + "expected " + key_name + " greater than the previous row's, got '" + a + "'");
-    }
-    log.keys_.push_back(k);
-    log.values_.push_back(v);
+  while (std::getline(in, line)) log.take_line(std::move(line));
+  if (!log.header_) {
+    throw InputError(source + ": empty stimulus log; expected the header 'frame,value' or 'time_s,value'");
   }
-  if (!header) throw InputError(source + ": empty stimulus log; expected the header 'frame,value' or 'time_s,value'");
   if (log.keys_.empty()) throw InputError(source + ": the stimulus log has a header but no rows");
   return log;
 }
 
+void StimulusLog::take_line(std::string line) {
+  const int lineno = ++lines_;
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (lineno == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+  const std::string t = trim(line);
+  if (t.empty() || t[0] == '#') return;
+  const auto comma = t.find(',');
+  const std::string a = comma == std::string::npos ? t : trim(t.substr(0, comma));
+  const std::string b = comma == std::string::npos ? "" : trim(t.substr(comma + 1));
+  const std::string where = source_ + ":" + std::to_string(lineno) + ": ";
+  if (!header_) {
+    if (comma == std::string::npos || b != "value" || (a != "frame" && a != "time_s")) {
+      throw InputError(where + "expected the header 'frame,value' or 'time_s,value', got '" + t + "'");
+    }
+    key_ = a == "frame" ? Key::Frame : Key::Time;
+    header_ = true;
+    return;
+  }
+  const char* key_name = key_ == Key::Frame ? "a frame index" : "a time in seconds";
+  double k = 0, v = 0;
+  if (comma == std::string::npos || b.find(',') != std::string::npos) {
+    throw InputError(where + "expected two fields '<" + std::string(key_ == Key::Frame ? "frame" : "time_s") +
+                     ">,<value>', got '" + t + "'");
+  }
+  if (!parse_number(a, k) || (key_ == Key::Frame && (k < 0 || k != std::floor(k)))) {
+    throw InputError(where + "expected " + key_name + " in the first field, got '" + a + "'");
+  }
+  if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got '" + b + "'");
+  if (!keys_.empty() && !(k > keys_.back())) {
+    throw InputError(where + "expected " + key_name + " greater than the previous row's, got '" + a + "'");
+  }
+  keys_.push_back(k);
+  values_.push_back(v);
+}
+
+StimulusLog StimulusLog::follow(const std::filesystem::path& file) {
+  StimulusLog log;
+  log.source_ = file.string();
+  log.followed_ = file;
+  std::ifstream probe(file, std::ios::binary);
+  if (!probe) throw InputError(file.string() + ": cannot open the stimulus log");
+  log.poll();
+  return log;
+}
+
+bool StimulusLog::poll() {
+  if (followed_.empty()) return false;
+  std::ifstream in(followed_, std::ios::binary);
+  if (!in) return false;  // moved away for a moment: keep the readings so far
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < read_to_) {
+    throw InputError(source_ + ": the stimulus log shrank while it was followed (from " + std::to_string(read_to_) +
+                     " to " + std::to_string(size) + " bytes)");
+  }
+  if (size == read_to_) return false;
+  in.seekg(read_to_);
+  std::string fresh(static_cast<size_t>(size - read_to_), '\0');
+  in.read(fresh.data(), static_cast<std::streamsize>(fresh.size()));
+  fresh.resize(static_cast<size_t>(in.gcount()));
+  // Whole lines only: the logger may be half way through the last one.
+  const size_t end = fresh.rfind('\n');
+  if (end == std::string::npos) return false;
+  const size_t rows_before = keys_.size();
+  size_t start = 0;
+  while (start <= end) {
+    const size_t nl = fresh.find('\n', start);
+    take_line(fresh.substr(start, nl - start));
+    start = nl + 1;
+  }
+  read_to_ += static_cast<std::streamoff>(end + 1);
+  return keys_.size() > rows_before;
+}
+
+std::optional<double> StimulusLog::latest() const {
+  if (values_.empty()) return std::nullopt;
+  return values_.back();
+}
+
 std::optional<double> StimulusLog::value_at(int frame, double time_s) const {
+  if (keys_.empty()) return std::nullopt;
   const double k = key_ == Key::Frame ? static_cast<double>(frame) : time_s;
   // A small tolerance keeps time keys written with rounding inside the log.
   const double eps = key_ == Key::Frame ? 0.0 : 1e-9;

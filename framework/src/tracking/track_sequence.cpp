@@ -116,7 +116,15 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   const auto start = Clock::now();
   // Inputs are checked before anything is written.
   std::optional<StimulusLog> log;
-  if (options.stimulus_csv) log = StimulusLog::load(*options.stimulus_csv);
+  if (options.follow_stimulus && !options.stimulus_csv) {
+    throw InputError("following the stimulus log needs a log (--stimulus FILE)");
+  }
+  if (options.follow_stimulus && options.resume) {
+    throw InputError("a run that follows its stimulus log cannot be resumed: which reading each finished frame took is not recorded");
+  }
+  if (options.stimulus_csv) {
+    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
+  }
   // Resuming: the saved state says which frame was done last; the source
   // starts at the next frame of the range.
   const fs::path state_file = options.out_dir / "tracker_state.txt";
@@ -146,6 +154,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   bool warned_range = false;
   const auto reading_at = [&](int index, double time_s) -> std::optional<double> {
     if (!log) return std::nullopt;
+    if (options.follow_stimulus) {
+      log->poll();
+      return log->latest();
+    }
     std::optional<double> reading = log->value_at(index, time_s);
     if (!reading) {
       if (!warned_range) {
