@@ -120,7 +120,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     throw InputError("following the stimulus log needs a log (--stimulus FILE)");
   }
   if (options.follow_stimulus && options.resume) {
-    throw InputError("a run that follows its stimulus log cannot be resumed: which reading each finished frame took is not recorded");
+    throw InputError(
+        "a run that follows its stimulus log cannot be resumed: which reading each finished frame took is not "
+        "recorded");
   }
   if (options.stimulus_csv) {
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
@@ -190,7 +192,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   const bool want_overlay = options.overlay.value_or(config.tracker.overlay);
   char overlay_stem[48] = "overlay";
-  if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", resumed->frame + 1);
+  if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", range.first);
   OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem);
   Progress progress(options.progress, expected_frames(*source, range), config.tracker.progress_every);
 
