@@ -17,6 +17,7 @@ namespace po = boost::program_options;
 namespace {
 
 std::atomic<bool> g_stop{false};
+std::atomic<bool> g_reader_gone{false};  // --stream: stdout's reader closed the pipe
 
 // The first Ctrl-C lets the current frame finish and the files close; the
 // handler then reverts to the default, so a second one ends the process.
@@ -59,16 +60,25 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   // as it is made (for a controller reading a pipe); the rest goes to stderr.
   const bool stream = vm.count("stream") > 0;
   if (stream) {
+    // A reader that goes away (the controller stopped) ends the run like
+    // Ctrl-C does, files closed, instead of SIGPIPE killing the process.
+    std::signal(SIGPIPE, SIG_IGN);
     opt.on_frame = [](const gtrack::Estimate& e) {
-      std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout);
-      std::fflush(stdout);
+      if (g_reader_gone) return;
+      if (std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
+        g_reader_gone = true;
+        g_stop = true;
+      }
     };
   }
   opt.cancel = &g_stop;
   install_sigint();
 
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
-  if (s.cancelled) {
+  if (s.cancelled && g_reader_gone) {
+    std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames
+              << " frames, kept in " << opt.out_dir.string() << " (the same command with --resume continues)\n";
+  } else if (s.cancelled) {
     std::cerr << "gtrack track: interrupted; " << s.frames << " finished frames kept in " << opt.out_dir.string()
               << " (the same command with --resume continues)\n";
   }
@@ -79,7 +89,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (s.resumed_after >= 0) {
     std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
   }
-  return s.cancelled ? 130 : 0;
+  if (s.cancelled) return g_reader_gone ? 141 : 130;  // 141: as a process ended by SIGPIPE
+  return 0;
 }
 
 }  // namespace

@@ -117,6 +117,26 @@ TEST(Cli, StreamPrintsEachEstimateOnStdout) {
   EXPECT_EQ(r.output.rfind("{\"frame\":0,", 0), 0u) << r.output;
 }
 
+// The reader of --stream goes away (`| head -n 1`): the run stops at the
+// next frame with its files closed and says so in one line, instead of
+// dying of SIGPIPE.
+TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "stream_closed";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 30 --seed 4 --out " + dir.string()).code, 0);
+  const fs::path err = dir / "stderr.txt";
+  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                              " -o " + (dir / "out").string() + " --no-overlay --stream",
+                          "2>" + err.string() + " | head -n 1");
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  std::ifstream in(err);
+  const std::string e((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(e.find("gtrack track: stdout was closed by its reader; stopped after "), std::string::npos) << e;
+  std::ifstream summary(dir / "out" / "summary.json");
+  const std::string s((std::istreambuf_iterator<char>(summary)), std::istreambuf_iterator<char>());
+  EXPECT_NE(s.find("\"cancelled\": true"), std::string::npos) << s;
+}
+
 TEST(Cli, UsageErrors) {
   EXPECT_EQ(gtrack("rendr").code, 2);
   EXPECT_EQ(gtrack("render").code, 2);
