@@ -100,7 +100,8 @@ class GTRACK_API Tracker {
   // Forget the history: the next frame starts like the first.
   void reset();
   TrackerState state() const;
-  // Continue from a state (of a tracker with the same setup and config).
+  // Continue from a state (of a tracker with the same setup and config);
+  // gtrack::Error when its configurations are not of this setup's size.
   void restore(const TrackerState& state);
   // Feeds a past frame's reading to the stimulus plugin as process() would,
   // without tracking: replayed in order, it rebuilds the plugin's state.

@@ -137,12 +137,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   if (options.resume && fs::exists(state_file)) {
     resumed = read_tracker_state(state_file);
-    for (const auto* v : {&resumed->last, &resumed->before_last}) {
-      if (*v && (*v)->size() != config.space.dims()) {
-        throw InputError(state_file.string() + ": holds a configuration of " + std::to_string((*v)->size()) +
-                         " values, this setup has " + std::to_string(config.space.dims()) + "; cannot resume");
-      }
-    }
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
@@ -172,6 +166,15 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     return reading;
   };
 
+  Tracker tracker(setup, config);
+  if (resumed) {
+    // Refused (a state of another setup) before any file is touched.
+    try {
+      tracker.restore(*resumed);
+    } catch (const Error& e) {
+      throw InputError(state_file.string() + ": " + e.what() + "; cannot resume");
+    }
+  }
   // The files are cut back to the frame the saved state records.
   std::vector<int> done;
   if (resumed) done = resume_results(options.out_dir, setup.model().fingers(), resumed->frame);
@@ -181,12 +184,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     fs::create_directories(options.out_dir / "masks", ec);
     if (ec) throw InputError((options.out_dir / "masks").string() + ": cannot create (" + ec.message() + ")");
   }
-  Tracker tracker(setup, config);
   if (resumed) {
     // The stimulus plugin's state is rebuilt by replaying the readings of
     // the frames already done, in order.
     for (const int index : done) tracker.replay_stimulus(reading_at(index, index / fps), index / fps);
-    tracker.restore(*resumed);
     logger().info("resuming after frame {} ({} frames already in {})", resumed->frame, done.size(),
                   options.out_dir.string());
   }

@@ -430,7 +430,7 @@ void Tracker::restore(const TrackerState& s) {
   const int dims = impl_->config.space.dims();
   for (const auto* h : {&s.last, &s.before_last}) {
     if (*h && (*h)->size() != dims) {
-      throw Error("tracker state: a configuration of " + std::to_string((*h)->size()) + " values, expected " +
+      throw Error("holds a configuration of " + std::to_string((*h)->size()) + " values, this setup has " +
                   std::to_string(dims));
     }
   }
