@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "gtrack/error.hpp"
+#include "replace_file.hpp"
 
 namespace gtrack {
 
@@ -55,18 +56,11 @@ int row_frame(const std::string& line, const std::string& prefix) {
   return std::stoi(line.substr(pos, end - pos));
 }
 
-// Replaces a file by its lines, through a temporary file and a rename.
+// Replaces a file by its lines.
 void rewrite(const fs::path& p, const std::vector<std::string>& lines) {
-  const fs::path tmp = p.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc | std::ios::binary);
-    for (const auto& l : lines) out << l << '\n';
-    out.flush();
-    if (!out) throw InputError(tmp.string() + ": write failed");
-  }
-  std::error_code ec;
-  fs::rename(tmp, p, ec);
-  if (ec) throw InputError(p.string() + ": cannot replace (" + ec.message() + ")");
+  std::string text;
+  for (const auto& l : lines) text += l + '\n';
+  detail::replace_file(p, text);
 }
 
 }  // namespace

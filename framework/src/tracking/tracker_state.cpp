@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gtrack/error.hpp"
+#include "replace_file.hpp"
 
 namespace gtrack {
 
@@ -36,22 +37,15 @@ void write_vector(std::ostream& out, const char* name, const std::optional<Eigen
 }  // namespace
 
 void write_tracker_state(const fs::path& file, const TrackerState& s) {
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << "gtrack-tracker-state 1\n"
-        << "frame " << s.frame << "\n"
-        << "lost " << s.lost << "\n"
-        << "started " << (s.started ? 1 : 0) << "\n"
-        << "reference_area " << s.reference_area << "\n";
-    write_vector(out, "last", s.last);
-    write_vector(out, "before_last", s.before_last);
-    out.flush();
-    if (!out) throw InputError(tmp.string() + ": write failed");
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) throw InputError(file.string() + ": cannot replace (" + ec.message() + ")");
+  std::ostringstream out;
+  out << "gtrack-tracker-state 1\n"
+      << "frame " << s.frame << "\n"
+      << "lost " << s.lost << "\n"
+      << "started " << (s.started ? 1 : 0) << "\n"
+      << "reference_area " << s.reference_area << "\n";
+  write_vector(out, "last", s.last);
+  write_vector(out, "before_last", s.before_last);
+  detail::replace_file(file, out.str());
 }
 
 TrackerState parse_tracker_state(std::string_view text, const std::string& name) {
