@@ -56,6 +56,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (vm.count("no-overlay")) opt.overlay = false;
   opt.resume = vm.count("resume") > 0;
   opt.follow_stimulus = vm.count("follow-stimulus") > 0;
+  if (vm.count("restart-from")) opt.restart_from = vm["restart-from"].as<std::string>();
   // --stream: each estimate, as its estimates.jsonl line, on stdout as soon
   // as it is made (for a controller reading a pipe); the rest goes to stderr.
   const bool stream = vm.count("stream") > 0;
@@ -109,6 +110,8 @@ GTRACK_COMMAND(
           "no-overlay", "do not write the overlay video")(
           "resume", "continue the run whose files are in OUT after its last finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
-          "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row");
+          "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(
+          "restart-from", po::value<std::string>(),
+          "pose table (e.g. ground_truth.csv): before each frame, set the track to its row for the previous frame");
     },
     run_track)

@@ -2,11 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -135,6 +138,66 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   std::ifstream summary(dir / "out" / "summary.json");
   const std::string s((std::istreambuf_iterator<char>(summary)), std::istreambuf_iterator<char>());
   EXPECT_NE(s.find("\"cancelled\": true"), std::string::npos) << s;
+}
+
+std::vector<std::vector<std::string>> read_csv(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    std::string c;
+    while (std::getline(ss, c, ',')) cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// --restart-from TABLE: each frame is tracked from the table's row for the
+// previous frame. A run that starts at frame 5 would begin with the coarse
+// search; from the ground truth it tracks frame 5 from frame 4's truth, and
+// every estimate lies near its own truth.
+TEST(Cli, RestartFromTheTruthTracksEachFrameFromThePreviousTruth) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "restart";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 9 --seed 3 --out " + dir.string()).code, 0);
+  const std::string track = "track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                            " -s " + (dir / "stimulus.csv").string() + " --frames 5:9 --no-overlay -o ";
+  CliRun r = gtrack(track + (dir / "plain").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = gtrack(track + (dir / "restarted").string() + " --restart-from " + (dir / "ground_truth.csv").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto truth = read_csv(dir / "ground_truth.csv");
+  const auto plain = read_csv(dir / "plain" / "estimates.csv");
+  const auto restarted = read_csv(dir / "restarted" / "estimates.csv");
+  ASSERT_EQ(plain.size(), 5u);
+  ASSERT_EQ(restarted.size(), 5u);
+  const int status = 14;  // frame, 12 parameters, cost, status
+  ASSERT_EQ(restarted[0][status], "status");
+  EXPECT_EQ(plain[1][status], "search");
+  for (int i = 1; i <= 4; ++i) {
+    EXPECT_EQ(restarted[i][status], "ok") << i;
+    const auto& t = truth[5 + i];
+    ASSERT_EQ(restarted[i][0], t[0]);
+    const double dx = std::stod(restarted[i][1]) - std::stod(t[1]), dy = std::stod(restarted[i][2]) - std::stod(t[2]);
+    EXPECT_LT(std::hypot(dx, dy), 0.06) << "frame " << t[0];
+  }
+}
+
+TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "restart_other";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 3 --out " + dir.string()).code, 0);
+  const fs::path table = write("two_fingers.csv",
+                               "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg\n0,0,0,100,0,0,0,0,0\n");
+  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                          " --no-overlay -o " + (dir / "out").string() + " --restart-from " + table.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(table.string() + ": has 2 joint columns, the gripper of this config has 6"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST(Cli, UsageErrors) {

@@ -141,6 +141,13 @@ struct TrackOptions {
   // The stimulus log is still being written (a live run): before each frame
   // its new rows are read, and the frame takes the last row's reading.
   bool follow_stimulus = false;
+  // A pose table (ground_truth.csv, or another run's estimates.csv): before
+  // each frame the track is set to the table's row for the range's previous
+  // frame, so each estimate is one frame of tracking from that row. With the
+  // ground truth it separates what one frame's search adds from what
+  // accumulates over a sequence. Frames whose previous row is missing are
+  // tracked from the track as it is.
+  std::optional<std::filesystem::path> restart_from;
   std::function<void(const Estimate&)> on_frame;  // called after each frame is written
 };
 

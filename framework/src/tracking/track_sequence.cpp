@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -10,6 +11,7 @@
 #include "gtrack/frame_source.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/results.hpp"
+#include "gtrack/sequence_io.hpp"
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
 
@@ -124,6 +126,15 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         "a run that follows its stimulus log cannot be resumed: which reading each finished frame took is not "
         "recorded");
   }
+  std::map<int, Eigen::VectorXd> restart_rows;
+  if (options.restart_from) {
+    const PoseTable table = read_pose_table(*options.restart_from);
+    if (table.fingers != setup.model().fingers()) {
+      throw InputError(options.restart_from->string() + ": has " + std::to_string(table.fingers) +
+                       " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
+    }
+    for (const auto& row : table.rows) restart_rows[row.frame] = row.h;
+  }
   if (options.stimulus_csv) {
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
   }
@@ -215,6 +226,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   double cost_sum = 0, ms_sum = 0;
   StageTimes sums;
+  int previous_index = -1;  // the last frame tracked by this run
   for (;;) {
     if (options.cancel && options.cancel->load()) {
       summary.cancelled = true;
@@ -227,7 +239,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const double time_s = frame->index / fps;
     const std::optional<double> reading = reading_at(frame->index, time_s);
 
+    if (!restart_rows.empty()) {
+      const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
+      if (row != restart_rows.end()) tracker.set_estimate(row->second);
+    }
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
+    previous_index = frame->index;
 
     const auto t_write = Clock::now();
     if (options.save_masks) {
