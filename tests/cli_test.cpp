@@ -200,6 +200,45 @@ TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {
       << r.output;
 }
 
+int count_files(const fs::path& dir, const std::string& extension) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) n += e.path().extension() == extension;
+  return n;
+}
+
+// A second sequence written into the folder of a longer one: its frames
+// alone are left, so tracking the folder tracks this sequence only.
+TEST(Cli, SynthIntoAnEarlierSequenceLeavesOnlyItsOwnFrames) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_again";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 4 --seed 1 --out " + dir.string()).code, 0);
+  std::ofstream(dir / "frames" / "notes.txt") << "kept\n";
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 2 --out " + dir.string()).code, 0);
+  EXPECT_EQ(count_files(dir / "frames", ".png"), 2);
+  EXPECT_TRUE(fs::exists(dir / "frames" / "notes.txt"));  // not a frame: left alone
+}
+
+// A fresh run into the folder of an earlier one replaces it: no overlay,
+// mask or row of the earlier run is left beside the new results.
+TEST(Cli, TrackIntoAnEarlierRunReplacesIt) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "track_again";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 5 --out " + dir.string()).code, 0);
+  const std::string track =
+      "track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() + " -o " + (dir / "out").string();
+  CliRun r = gtrack(track + " --save-masks");
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(count_files(dir / "out" / "masks", ".png"), 3);
+  ASSERT_TRUE(fs::exists(dir / "out" / "overlay.mp4") || fs::exists(dir / "out" / "overlay.avi"));
+  r = gtrack(track + " --frames 0:2 --no-overlay");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("holds an earlier run: it is replaced"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "overlay.mp4"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "overlay.avi"));
+  EXPECT_EQ(count_files(dir / "out" / "masks", ".png"), 0);
+  EXPECT_EQ(read_csv(dir / "out" / "estimates.csv").size(), 3u);  // header and frames 0, 1
+}
+
 TEST(Cli, UsageErrors) {
   EXPECT_EQ(gtrack("rendr").code, 2);
   EXPECT_EQ(gtrack("render").code, 2);

@@ -35,6 +35,15 @@ GTRACK_API std::string estimate_json(const Estimate& estimate);
 
 GTRACK_API void write_summary(const std::filesystem::path& file, const TrackSummary& summary);
 
+// Removes the frame images (NNNNNN.png) in dir, as gtrack writes them for
+// sequences and masks; returns how many. Other files are left alone.
+GTRACK_API int remove_frame_images(const std::filesystem::path& dir);
+
+// A fresh run into a folder that holds an earlier one: removes the files of
+// that run this one might not rewrite (overlay videos, masks, the tracker
+// state), so nothing of the two is mixed. Returns how many were removed.
+GTRACK_API int clear_previous_run(const std::filesystem::path& out_dir);
+
 // Prepares out_dir for a resumed run: keeps the rows of estimates.csv and
 // estimates.jsonl up to frame `last` (a row cut short by an interruption, or
 // written after the state was, is dropped) and returns the frame indices

@@ -10,6 +10,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "gtrack/results.hpp"
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/synth.hpp"
 
@@ -22,6 +23,11 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   std::error_code ec;
   fs::create_directories(out / "frames", ec);
   if (ec) throw InputError(out.string() + ": cannot create the folder (" + ec.message() + ")");
+  // The frames of an earlier sequence in the same folder would be tracked
+  // with this one's.
+  if (const int stale = remove_frame_images(out / "frames")) {
+    logger().info("{}: removed the {} frames of an earlier sequence", (out / "frames").string(), stale);
+  }
 
   const SynthPlan plan = plan_sequence(setup, options);
   const int n = static_cast<int>(plan.frames.size());

@@ -142,6 +142,48 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
   if (!out) throw InputError(file.string() + ": write failed");
 }
 
+namespace {
+
+void remove_all_of(const std::vector<fs::path>& files) {
+  std::error_code ec;
+  for (const auto& p : files) {
+    fs::remove(p, ec);
+    if (ec) throw InputError(p.string() + ": cannot remove the file of an earlier run (" + ec.message() + ")");
+  }
+}
+
+}  // namespace
+
+int remove_frame_images(const fs::path& dir) {
+  std::error_code ec;
+  std::vector<fs::path> found;
+  if (!fs::is_directory(dir, ec)) return 0;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string n = entry.path().filename().string();
+    if (n.size() == 10 && entry.path().extension() == ".png" &&
+        std::all_of(n.begin(), n.begin() + 6, [](char c) { return c >= '0' && c <= '9'; })) {
+      found.push_back(entry.path());
+    }
+  }
+  remove_all_of(found);
+  return static_cast<int>(found.size());
+}
+
+int clear_previous_run(const fs::path& out_dir) {
+  std::error_code ec;
+  if (!fs::is_directory(out_dir, ec)) return 0;
+  std::vector<fs::path> stale;
+  for (const auto& entry : fs::directory_iterator(out_dir, ec)) {
+    const fs::path& p = entry.path();
+    const std::string n = p.filename().string();
+    const bool overlay = (n.rfind("overlay.", 0) == 0 || n.rfind("overlay_from_", 0) == 0) &&
+                         (p.extension() == ".mp4" || p.extension() == ".avi");
+    if (overlay || n == "tracker_state.txt") stale.push_back(p);
+  }
+  remove_all_of(stale);
+  return static_cast<int>(stale.size()) + remove_frame_images(out_dir / "masks");
+}
+
 std::vector<int> resume_results(const fs::path& out_dir, int fingers, int last) {
   const fs::path csv = out_dir / "estimates.csv", jsonl = out_dir / "estimates.jsonl";
   if (!fs::exists(csv)) throw InputError(csv.string() + ": missing; there is nothing to resume");

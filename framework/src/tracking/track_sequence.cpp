@@ -188,7 +188,15 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   // The files are cut back to the frame the saved state records.
   std::vector<int> done;
-  if (resumed) done = resume_results(options.out_dir, setup.model().fingers(), resumed->frame);
+  if (resumed) {
+    done = resume_results(options.out_dir, setup.model().fingers(), resumed->frame);
+  } else {
+    // A fresh run replaces whatever an earlier one left in the folder.
+    const bool earlier = fs::exists(options.out_dir / "estimates.csv");
+    if (clear_previous_run(options.out_dir) > 0 || earlier) {
+      logger().info("{} holds an earlier run: it is replaced", options.out_dir.string());
+    }
+  }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
   if (options.save_masks) {
     std::error_code ec;
