@@ -316,6 +316,37 @@ TEST(GlRenderer, BatchesOfAnySizeMatchOneAtATime) {
   }
 }
 
+// The render target keeps the layers of the largest batch: a smaller batch
+// after it, and a mask, see nothing of what the larger one drew there.
+TEST(GlRenderer, ABatchAfterALargerOneSeesNothingOfIt) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(130, 5, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(8));
+  auto cpu = make_cpu();
+  for (Renderer* r : {gl.get(), cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+  }
+  std::vector<PairCounts> want, got;
+  cpu->evaluate(H, want);
+  // Large, smaller, one, larger again, and the layer boundaries in between.
+  for (int n : {130, 40, 1, 33, 130, 7}) {
+    // A different slice each time, so that stale bits would change the counts.
+    const int first = (n * 7) % (130 - n + 1);
+    gl->evaluate(H.middleCols(first, n), got);
+    ASSERT_EQ(got.size(), static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      EXPECT_TRUE(counts_agree(got[i].rendered, want[first + i].rendered)) << "batch " << n << ", hypothesis " << i;
+      EXPECT_TRUE(counts_agree(got[i].intersection, want[first + i].intersection))
+          << "batch " << n << ", hypothesis " << i;
+    }
+    const cv::Mat mask = gl->render_mask(H.col(first));
+    EXPECT_TRUE(masks_agree(mask, cpu->render_mask(H.col(first)))) << "mask after a batch of " << n;
+  }
+}
+
 TEST(GlRenderer, SubmitReturnsAndFinishCollects) {
   GL_OR_SKIP(gl);
   Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
@@ -329,6 +360,8 @@ TEST(GlRenderer, SubmitReturnsAndFinishCollects) {
 
   gl->submit(H);
   EXPECT_THROW(gl->submit(H), gtrack::Error);
+  // The buffers the counts come back through may not be replaced meanwhile.
+  EXPECT_THROW(gl->set_model(s.model), gtrack::Error);
   // A mask may be rendered while a batch is in flight; the batch keeps its counts.
   const cv::Mat m = gl->render_mask(H.col(5));
   gl->finish(b);

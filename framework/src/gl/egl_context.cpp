@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 
 namespace gtrack::gl {
 
@@ -159,6 +160,9 @@ EglContext EglContext::open(const ContextRequest& request) {
     if (order.empty()) why = "no EGL device and no Mesa surfaceless platform (is an EGL vendor library installed?)";
     throw Error("gl backend: no EGL context with OpenGL 4.5 core could be created: " + why);
   }
+  // A device tried first that failed (a GPU without its EGL vendor library,
+  // say) is worth knowing about when a slower one was taken instead.
+  if (!why.empty()) logger().warn("gl backend: using {} after: {}", context.display_label(), why);
   return context;
 }
 

@@ -148,6 +148,8 @@ void GlRenderer::release() noexcept {
 }
 
 void GlRenderer::set_model(const ArticulatedModel& model) {
+  // The buffers a pending batch's counts come back through may be replaced.
+  if (pending_ >= 0) throw Error("gl backend: set_model() while a batch is pending; call finish() first");
   context_.make_current();
   wait_for_fence();
   const auto& mesh = model.mesh();
@@ -290,17 +292,21 @@ void GlRenderer::reserve_hypotheses(int count) {
   if (readback_ == nullptr) throw Error("gl backend: cannot map the count buffer");
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kHypotheses, hypothesis_buffer_);
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kCounts, count_buffer_);
+  gl_.check(("allocating buffers for " + std::to_string(capacity) + " hypotheses").c_str());
   hypothesis_capacity_ = capacity;
 }
 
 void GlRenderer::reserve_layers(int layers) {
-  if (layers == layer_capacity_ && target_ != 0) return;
+  // Grow-only: a batch smaller than the largest so far uses the first layers
+  // of the target, and nothing is reallocated from one batch to the next.
+  if (layers <= layer_capacity_ && target_ != 0) return;
   GLint max_layers = 0;
   gl_.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   if (layers > max_layers) {
     throw Error("gl backend: " + std::to_string(layers * kLayerBits) + " hypotheses need " + std::to_string(layers) +
                 " layers, the driver allows " + std::to_string(max_layers));
   }
+  layers = std::min(std::max(layers, 2 * layer_capacity_), static_cast<int>(max_layers));
   if (target_ != 0) gl_.DeleteTextures(1, &target_);
   gl_.CreateTextures(GL_TEXTURE_2D_ARRAY, 1, &target_);
   gl_.TextureStorage3D(target_, 1, GL_R32UI, projection_.size.width, projection_.size.height, layers);
@@ -316,6 +322,7 @@ void GlRenderer::reserve_layers(int layers) {
   delete_buffer(gl_, box_buffer_);
   box_buffer_ = make_buffer(gl_, GLsizeiptr(layers) * GLsizeiptr(sizeof(PixelBox)), nullptr, GL_DYNAMIC_STORAGE_BIT);
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBoxes, box_buffer_);
+  gl_.check(("allocating a render target of " + std::to_string(layers) + " layers").c_str());
   layer_capacity_ = layers;
 }
 
@@ -326,12 +333,11 @@ void GlRenderer::upload_hypotheses(const double* data, int count) {
 }
 
 void GlRenderer::draw(int count) {
-  // A framebuffer clear lets the driver clear as it renders (llvmpipe
-  // applies it per tile; on llvmpipe it costs no more than no clear at all,
-  // within measurement noise). It covers every layer of the target, which
-  // is why the target has exactly the layers of the last batch.
-  const GLuint zero[4] = {0, 0, 0, 0};
-  gl_.ClearNamedFramebufferuiv(framebuffer_, GL_COLOR, 0, zero);
+  // Only the layers this batch draws into are cleared: the target keeps the
+  // layers of the largest batch so far.
+  const GLuint zero = 0;
+  gl_.ClearTexSubImage(target_, 0, 0, 0, 0, projection_.size.width, projection_.size.height, layers_for(count),
+                       GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   gl_.UseProgram(draw_program_);
   gl_.DrawArraysInstanced(GL_TRIANGLES, 0, vertices_, count);
 }
@@ -382,14 +388,20 @@ void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
 
 void GlRenderer::wait_for_fence() {
   if (fence_ == nullptr) return;
-  for (;;) {
+  // A batch takes milliseconds; a GPU that has not finished one in a minute
+  // has hung or been reset, and waiting longer would hang the run with it.
+  constexpr int kMaxWaitSeconds = 60;
+  for (int waited = 0;; ++waited) {
     const GLenum r = gl_.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000ull);
     if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) break;
-    if (r == GL_WAIT_FAILED) {
+    if (r == GL_WAIT_FAILED || waited + 1 >= kMaxWaitSeconds) {
       gl_.DeleteSync(fence_);
       fence_ = nullptr;
-      gl_.check("waiting for the GPU");
-      throw Error("gl backend: waiting for the GPU failed");
+      pending_ = -1;
+      if (r == GL_WAIT_FAILED) gl_.check("waiting for the GPU");
+      throw Error(r == GL_WAIT_FAILED ? std::string("gl backend: waiting for the GPU failed")
+                                      : "gl backend: the GPU did not finish a batch in " +
+                                            std::to_string(kMaxWaitSeconds) + " s (hung or reset)");
     }
   }
   gl_.DeleteSync(fence_);
@@ -416,17 +428,16 @@ cv::Mat GlRenderer::render_mask(const Eigen::VectorXd& hypothesis) {
   reserve_hypotheses(1);
   upload_hypotheses(hypothesis.data(), 1);
   draw(1);
+  // Layer 0 holds this one hypothesis alone, in bit 0: read as bytes, the
+  // texels are 0 or 1 (a quarter of the 32-bit texels' bytes).
   const int w = projection_.size.width, h = projection_.size.height;
-  std::vector<std::uint32_t> bits(static_cast<size_t>(w) * static_cast<size_t>(h));
-  gl_.GetTextureSubImage(target_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
-                         GLsizei(bits.size() * sizeof(std::uint32_t)), bits.data());
-  gl_.check("reading a mask back");
   cv::Mat mask(h, w, CV_8UC1);
-  for (int y = 0; y < h; ++y) {
-    auto* row = mask.ptr<std::uint8_t>(y);
-    const std::uint32_t* src = bits.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
-    for (int x = 0; x < w; ++x) row[x] = (src[x] & 1u) ? 255 : 0;
-  }
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl_.GetTextureSubImage(target_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+                         GLsizei(mask.total()), mask.data);
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.check("reading a mask back");
+  mask *= 255;
   return mask;
 }
 

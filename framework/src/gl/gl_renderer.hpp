@@ -65,7 +65,7 @@ class GlRenderer final : public Renderer {
   const std::uint32_t* readback_ = nullptr;  // persistent, coherent mapping of readback_buffer_
 
   int hypothesis_capacity_ = 0;
-  int layer_capacity_ = 0;  // layers of target_: those of the last batch
+  int layer_capacity_ = 0;  // layers of target_: at least those of the largest batch so far
   int max_clip_planes_ = 0;
 
   int dims_ = 0;

@@ -36,6 +36,8 @@ double model_reach_mm(const ArticulatedModel& model) {
 
 PixelBox hypothesis_box(const Projection& projection, const Eigen::Vector3d& centre, double reach) {
   const PixelBox full{0, 0, projection.size.width, projection.size.height};
+  // A centre that is not a number draws nothing (its triangles are dropped).
+  if (!centre.allFinite()) return {};
   for (const Eigen::Vector4d& plane : projection.clip_planes) {
     const double n = plane.head<3>().norm();
     if (n > 0 && plane.head<3>().dot(centre) + plane.w() < -reach * n) return {};
