@@ -21,7 +21,7 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   const fs::path out = vm["out"].as<std::string>();
   gtrack::SynthOptions so;
   so.frames = vm["frames"].as<int>();
-  so.seed = vm["seed"].as<std::uint64_t>();
+  so.seed = gtrack::cli::seed_option(vm);
   so.preset = vm["preset"].as<std::string>();
   if (so.frames < 2) throw gtrack::cli::UsageError("--frames must be at least 2");
   const gtrack::SynthPreset& preset = gtrack::synth_preset(so.preset);
@@ -63,7 +63,9 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   std::cout << std::setprecision(1) << "\nresult over " << ev.evaluated_frames << " in-view frames ("
             << ev.lost_frames << " lost, " << ev.out_of_view_frames << " out of view), N=" << cfg.pso.particles
             << " G=" << cfg.pso.generations << ", " << track.renderer << " renderer, "
-            << (track.mean_ms > 0 ? 1000.0 / track.mean_ms : 0.0) << " frames/s:\n"
+            << (track.mean_ms > 0 ? 1000.0 / track.mean_ms : 0.0)
+            << " frames/s of tracking (segmentation and search; "
+            << (track.wall_s > 0 ? track.frames / track.wall_s : 0.0) << " frames/s with reading and writing):\n"
             << "  position in-plane " << e.position_inplane_um.mean << " +- " << e.position_inplane_um.std
             << " um   (paper: 25 +- 7 um)\n"
             << "  depth             " << e.depth_um.mean << " +- " << e.depth_um.std << " um\n"
@@ -76,7 +78,8 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
             << "frames and ground truth: " << seq.string() << "\n"
             << "overlay video:           "
             << (track.overlay_file.empty() ? std::string("(none written)") : track.overlay_file.string()) << "\n"
-            << "estimates:               " << (to.out_dir / "estimates.csv").string() << "\n"
+            << "estimates:               " << (to.out_dir / "estimates.csv").string() << " and "
+            << (to.out_dir / "estimates.jsonl").string() << "\n"
             << "evaluation:              " << (out / "evaluation.json").string() << " and "
             << (out / "frame_errors.csv").string() << "\n";
   return 0;
@@ -89,7 +92,7 @@ GTRACK_COMMAND(
     [](po::options_description& d) {
       d.add_options()("out,o", po::value<std::string>()->default_value("gtrack_demo"), "folder to write")(
           "frames,n", po::value<int>()->default_value(60), "frames to synthesise and track")(
-          "seed,s", po::value<std::uint64_t>()->default_value(1), "random seed of the sequence")(
+          "seed,s", po::value<std::string>()->default_value("1"), "random seed of the sequence")(
           "preset", po::value<std::string>()->default_value("microscope"), "synthetic setup");
     },
     run_demo)

@@ -2,10 +2,12 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <set>
 
 #include "command.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
 
 namespace po = boost::program_options;
@@ -22,6 +24,18 @@ void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) 
 int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   const fs::path truth_file = vm["truth"].as<std::string>();
   const fs::path estimates_file = vm["estimates"].as<std::string>();
+  for (const fs::path& f : {truth_file, estimates_file}) {
+    if (!fs::is_regular_file(f)) throw gtrack::InputError(f.string() + ": no such file");
+  }
+  // Where the results go is checked before anything is computed.
+  for (const char* key : {"json", "per-frame"}) {
+    if (!vm.count(key)) continue;
+    const fs::path out(vm[key].as<std::string>());
+    const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+    if (!fs::is_directory(dir)) {
+      throw gtrack::InputError(out.string() + ": the folder '" + dir.string() + "' does not exist (--" + key + ")");
+    }
+  }
   // The model comes from a config: the one given, or the sequence.toml that
   // 'gtrack synth' wrote next to its ground truth.
   fs::path config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
@@ -39,12 +53,33 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   gtrack::EvalOptions opt;
   opt.out_of_view_below = vm["out-of-view-below"].as<double>();
   opt.off_track_endpoint_um = vm["off-track-um"].as<double>();
+  if (!(opt.out_of_view_below >= 0 && opt.out_of_view_below < 1)) {
+    throw gtrack::cli::UsageError("--out-of-view-below must be a share in [0, 1)");
+  }
+  if (!(opt.off_track_endpoint_um > 0)) throw gtrack::cli::UsageError("--off-track-um must be positive");
   const auto truth = gtrack::read_pose_table(truth_file);
   const auto estimates = gtrack::read_pose_table(estimates_file);
+  for (const auto* t : {&truth, &estimates}) {
+    if (t->rows.empty()) {
+      throw gtrack::InputError((t == &truth ? truth_file : estimates_file).string() +
+                               ": a header and no rows; there is nothing to evaluate");
+    }
+  }
   if (estimates.fingers != setup.model().fingers()) {
     throw gtrack::InputError(estimates_file.string() + ": " + std::to_string(estimates.fingers) +
                              " joint columns, the model in " + config.string() + " has " +
                              std::to_string(setup.model().fingers()) + " fingers");
+  }
+  // Estimates of frames the truth does not have are not evaluated: said once.
+  std::set<int> truth_frames;
+  for (const auto& r : truth.rows) truth_frames.insert(r.frame);
+  std::vector<int> unmatched;
+  for (const auto& r : estimates.rows) {
+    if (!truth_frames.count(r.frame)) unmatched.push_back(r.frame);
+  }
+  if (!unmatched.empty()) {
+    gtrack::logger().warn("{}: {} rows are of frames {} has no row for (the first is frame {}); they are not evaluated",
+                          estimates_file.string(), unmatched.size(), truth_file.string(), unmatched.front());
   }
   const auto ev = gtrack::evaluate(setup.model(), truth, estimates, opt, setup.sensor.get());
 
@@ -52,15 +87,19 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
             << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames << " off track), "
             << ev.out_of_view_frames << " out of view; lost in all " << ev.lost_frames << " (missing "
             << ev.missing_frames << ")\n";
-  print_row("position 3D", ev.in_view.position_um, "um");
-  print_row("position in-plane", ev.in_view.position_inplane_um, "um");
-  print_row("depth", ev.in_view.depth_um, "um");
-  print_row("orientation", ev.in_view.orientation_deg, "deg");
-  print_row("  about x", ev.in_view.axis_deg[0], "deg");
-  print_row("  about y", ev.in_view.axis_deg[1], "deg");
-  print_row("  about z", ev.in_view.axis_deg[2], "deg");
-  print_row("joints", ev.in_view.joint_deg, "deg");
-  print_row("phalanx endpoints", ev.in_view.endpoint_um, "um");
+  if (ev.evaluated_frames == 0) {
+    std::cout << "  no frame in view has an estimate: there are no error figures\n";
+  } else {
+    print_row("position 3D", ev.in_view.position_um, "um");
+    print_row("position in-plane", ev.in_view.position_inplane_um, "um");
+    print_row("depth", ev.in_view.depth_um, "um");
+    print_row("orientation", ev.in_view.orientation_deg, "deg");
+    print_row("  about x", ev.in_view.axis_deg[0], "deg");
+    print_row("  about y", ev.in_view.axis_deg[1], "deg");
+    print_row("  about z", ev.in_view.axis_deg[2], "deg");
+    print_row("joints", ev.in_view.joint_deg, "deg");
+    print_row("phalanx endpoints", ev.in_view.endpoint_um, "um");
+  }
   std::cout << "  recovery: " << ev.recovery.size() << " returns into view, " << ev.frames_lost_after_return
             << " frames lost or off track after them\n";
   const std::string json = gtrack::evaluation_json(ev);
@@ -83,9 +122,9 @@ GTRACK_COMMAND(
           "config,c", po::value<std::string>(), "config naming the gripper (default: sequence.toml beside the truth)")(
           "json", po::value<std::string>(), "write the summary as JSON")(
           "per-frame", po::value<std::string>(), "write per-frame errors as CSV")(
-          "out-of-view-below", po::value<double>()->default_value(0.1),
+          "out-of-view-below", po::value<double>()->default_value(0.1, "0.1"),
           "share of the gripper inside the image under which a frame counts as out of view")(
-          "off-track-um", po::value<double>()->default_value(400.0),
+          "off-track-um", po::value<double>()->default_value(400.0, "400"),
           "mean endpoint error above which an estimate is off the gripper (recovery)");
     },
     run_eval)

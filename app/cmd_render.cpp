@@ -1,9 +1,11 @@
 // gtrack render: the model as the sensor sees it, as a mask and a posed mesh.
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "command.hpp"
+#include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/renderer.hpp"
 #include "gtrack/setup.hpp"
@@ -21,13 +23,32 @@ void write_obj(const std::string& path, const std::vector<Eigen::Vector3d>& tris
   if (!out) throw gtrack::InputError(path + ": write failed");
 }
 
+// Checked before anything is computed or written: the folder exists, and an
+// image's extension is one OpenCV can write.
+void check_writable(const std::string& path, bool image) {
+  const std::filesystem::path p(path);
+  const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    throw gtrack::InputError(path + ": the folder '" + dir.string() + "' does not exist");
+  }
+  if (image && !cv::haveImageWriter(path)) {
+    throw gtrack::InputError(path + ": cannot write images of this kind; expected .png, .jpg, .bmp, .tif, .pgm or .ppm");
+  }
+}
+
 int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   gtrack::SetupOptions so;
   so.plugin_paths = common.plugin_paths;
   so.with_stimulus = false;
   gtrack::Setup setup = gtrack::load_setup(vm["config"].as<std::string>(), so);
-  for (const auto& k : setup.root.keys()) setup.root.mark_used(k);  // engine tables are not used here
-  setup.root.check_all_used();
+  // The engine tables are not used here, but a config is checked whole, as
+  // `track` checks it: a typo found now is not a surprise later.
+  (void)gtrack::engine_config(setup);
+  gtrack::check_root_keys(setup);
+  const std::string out = vm["out"].as<std::string>();
+  check_writable(out, true);
+  if (vm.count("obj")) check_writable(vm["obj"].as<std::string>(), false);
 
   const auto& model = setup.model();
   const Eigen::VectorXd h = gtrack::parse_parameter_vector(vm["params"].as<std::string>(), model.dims());
@@ -39,8 +60,7 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   renderer->set_model(model);
   renderer->set_projection(setup.sensor->projection(), ro.scale);
   const cv::Mat mask = renderer->render_mask(h);
-  const std::string out = vm["out"].as<std::string>();
-  if (!cv::imwrite(out, mask)) throw gtrack::InputError(out + ": cannot write image (unknown extension or folder?)");
+  if (!cv::imwrite(out, mask)) throw gtrack::InputError(out + ": cannot write the image");
   std::cout << "mask " << mask.cols << "x" << mask.rows << " (" << cv::countNonZero(mask) << " pixels, "
             << renderer->name() << " backend) -> " << out << "\n";
   if (vm.count("obj")) {

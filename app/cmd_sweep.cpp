@@ -3,6 +3,7 @@
 //   6b: joint error when every hinge deviates from its finger's value by
 //       Gaussian noise of sd sigma (the model assumes they are equal).
 // Writes fig6a.csv / fig6b.csv and plots of them drawn with OpenCV.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -160,18 +161,39 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   c.common = common;
   c.out = vm["out"].as<std::string>();
   c.synth.frames = vm["frames"].as<int>();
-  c.synth.seed = vm["seed"].as<std::uint64_t>();
+  c.synth.seed = gtrack::cli::seed_option(vm);
   c.synth.preset = vm["preset"].as<std::string>();
   c.sequences = vm["sequences"].as<int>();
   if (c.synth.frames < 2 || c.sequences < 1) throw gtrack::cli::UsageError("--frames >= 2 and --sequences >= 1");
   c.config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
                                 : gtrack::data_dir() / "configs" / gtrack::synth_preset(c.synth.preset).config;
-  fs::create_directories(c.out);
   const auto particles = parse_list(vm["particles"].as<std::string>(), "particles");
   const auto generations = parse_list(vm["generations"].as<std::string>(), "generations");
   const auto sigmas = parse_list(vm["sigmas"].as<std::string>(), "sigmas");
   const std::string which = vm["figure"].as<std::string>();
   if (which != "6a" && which != "6b" && which != "both") throw gtrack::cli::UsageError("--figure: 6a, 6b or both");
+  // Every value is checked before the first sequence is made.
+  const auto at_least = [](const std::vector<double>& values, double lo, const char* option) {
+    for (double v : values) {
+      if (!(v >= lo) || v != std::floor(v)) {
+        std::ostringstream m;
+        m << "--" << option << ": expected whole numbers of at least " << lo << ", got " << v;
+        throw gtrack::cli::UsageError(m.str());
+      }
+    }
+  };
+  at_least(particles, 2, "particles");
+  at_least(generations, 1, "generations");
+  for (double v : sigmas) {
+    if (!(v >= 0)) {
+      std::ostringstream m;
+      m << "--sigmas: expected values of at least 0, got " << v;
+      throw gtrack::cli::UsageError(m.str());
+    }
+  }
+  if (vm["fig6b-particles"].as<int>() < 2) throw gtrack::cli::UsageError("--fig6b-particles must be at least 2");
+  if (vm["fig6b-generations"].as<int>() < 1) throw gtrack::cli::UsageError("--fig6b-generations must be at least 1");
+  fs::create_directories(c.out);
 
   if (which != "6b") {
     std::ofstream csv(c.out / "fig6a.csv");
@@ -217,7 +239,10 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
     plot(c.out / "fig6b.png", "Fig. 6b: joint error vs per-hinge noise", "noise sigma (deg)", "joint error (deg)",
          {s}, sigmas, false);
   }
-  std::cout << "results: " << c.out.string() << "/fig6a.csv, fig6a.png, fig6b.csv, fig6b.png\n";
+  std::cout << "results: " << c.out.string() << "/"
+            << (which == "6a" ? "fig6a.csv, fig6a.png" : which == "6b" ? "fig6b.csv, fig6b.png"
+                                                                       : "fig6a.csv, fig6a.png, fig6b.csv, fig6b.png")
+            << "\n";
   return 0;
 }
 
@@ -231,7 +256,7 @@ GTRACK_COMMAND(
           "preset", po::value<std::string>()->default_value("microscope"), "synthetic setup")(
           "frames,n", po::value<int>()->default_value(60), "frames per sequence (paper: 5614 frames in all)")(
           "sequences", po::value<int>()->default_value(1), "sequences per cell, seeds seed, seed+1, ...")(
-          "seed,s", po::value<std::uint64_t>()->default_value(1), "first seed")(
+          "seed,s", po::value<std::string>()->default_value("1"), "first seed")(
           "particles", po::value<std::string>()->default_value("8,16,32,64"), "values of N (6a)")(
           "generations", po::value<std::string>()->default_value("5,10,25,50"), "values of G (6a)")(
           "sigmas", po::value<std::string>()->default_value("0,0.5,1,1.5,2"), "per-hinge noise sd, deg (6b)")(

@@ -14,9 +14,10 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::SynthOptions o;
   o.preset = vm["preset"].as<std::string>();
   o.frames = vm["frames"].as<int>();
-  o.seed = vm["seed"].as<std::uint64_t>();
+  o.seed = gtrack::cli::seed_option(vm);
   o.joint_noise_deg = vm["joint-noise"].as<double>();
   o.threads = vm["threads"].as<int>();
+  if (o.threads < 0) throw gtrack::cli::UsageError("--threads must be 0 (all cores) or more");
   if (o.frames < 1) throw gtrack::cli::UsageError("--frames must be at least 1");
   if (o.joint_noise_deg < 0) throw gtrack::cli::UsageError("--joint-noise must not be negative");
   const gtrack::SynthPreset& preset = gtrack::synth_preset(o.preset);
@@ -48,7 +49,7 @@ GTRACK_COMMAND(
                       "TOML config naming sensor, gripper and stimulus (default: the preset's config)")(
           "out,o", po::value<std::string>()->required(), "folder to write")(
           "frames,n", po::value<int>()->default_value(300), "number of frames")(
-          "seed,s", po::value<std::uint64_t>()->default_value(1), "random seed: same seed, same sequence")(
+          "seed,s", po::value<std::string>()->default_value("1"), "random seed: same seed, same sequence")(
           "preset", po::value<std::string>()->default_value("microscope"), "setup: motion, look and noise")(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(

@@ -7,6 +7,9 @@
 #pragma once
 
 #include <boost/program_options.hpp>
+#include <charconv>
+#include <cstdint>
+#include <stdexcept>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -41,6 +44,18 @@ struct Registrar {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// --seed: a whole number from 0 to 2^64 - 1. Read as text, because the
+// option parser turns "-1" into 2^64 - 1 for an unsigned option.
+inline std::uint64_t seed_option(const boost::program_options::variables_map& vm) {
+  const std::string text = vm["seed"].as<std::string>();
+  std::uint64_t seed = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), seed);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
+    throw UsageError("--seed: expected a whole number of at least 0, got '" + text + "'");
+  }
+  return seed;
+}
 
 }  // namespace gtrack::cli
 

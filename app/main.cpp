@@ -2,6 +2,8 @@
 #include <boost/program_options.hpp>
 #include <cstdio>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "command.hpp"
 #include "gtrack/config.hpp"
@@ -44,6 +46,47 @@ void print_usage(std::ostream& os) {
   os << "\n" << common_options();
 }
 
+// An error line as the terminal should show it: control bytes (from a
+// binary file quoted in a message) as \xNN, so the line stays one line.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const unsigned char c : text) {
+    if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
+// The common options may also come before the command
+// (`gtrack --log-level debug plugins`): they are moved after it.
+std::vector<char*> command_first(int argc, char** argv) {
+  std::vector<char*> leading, rest;
+  int i = 1;
+  for (; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool with_value = a == "--log-level" || a == "--plugin-path";
+    const bool joined = a.rfind("--log-level=", 0) == 0 || a.rfind("--plugin-path=", 0) == 0;
+    if (with_value && i + 1 < argc) {
+      leading.push_back(argv[i]);
+      leading.push_back(argv[++i]);
+    } else if (joined) {
+      leading.push_back(argv[i]);
+    } else {
+      break;
+    }
+  }
+  std::vector<char*> out{argv[0]};
+  if (i < argc) out.push_back(argv[i++]);
+  out.insert(out.end(), leading.begin(), leading.end());
+  for (; i < argc; ++i) out.push_back(argv[i]);
+  return out;
+}
+
 int run(int argc, char** argv) {
   if (argc < 2) {
     print_usage(std::cerr);
@@ -65,7 +108,7 @@ int run(int argc, char** argv) {
   if (!cmd) {
     std::vector<std::string> names;
     for (const auto& c : registry()) names.push_back(c.name);
-    std::string msg = "gtrack: unknown command '" + first + "'";
+    std::string msg = "gtrack: error: unknown command '" + printable(first) + "'";
     if (auto m = gtrack::closest_match(first, names)) msg += " (did you mean '" + *m + "'?)";
     std::cerr << msg << "; run 'gtrack --help' for the list\n";
     return 2;
@@ -90,7 +133,7 @@ int run(int argc, char** argv) {
     }
     po::notify(vm);
   } catch (const po::error& e) {
-    std::cerr << "gtrack " << cmd->name << ": " << e.what() << " (see 'gtrack " << cmd->name << " --help')\n";
+    std::cerr << "gtrack: error: " << printable(e.what()) << " (see 'gtrack " << cmd->name << " --help')\n";
     return 2;
   }
 
@@ -107,15 +150,16 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   try {
-    return run(argc, argv);
+    std::vector<char*> args = command_first(argc, argv);
+    return run(static_cast<int>(args.size()), args.data());
   } catch (const gtrack::cli::UsageError& e) {
-    std::cerr << "gtrack: " << e.what() << "\n";
+    std::cerr << "gtrack: error: " << printable(e.what()) << "\n";
     return 2;
   } catch (const gtrack::Error& e) {
-    std::cerr << "gtrack: error: " << e.what() << "\n";
+    std::cerr << "gtrack: error: " << printable(e.what()) << "\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "gtrack: error: " << e.what() << "\n";
+    std::cerr << "gtrack: error: " << printable(e.what()) << "\n";
     return 1;
   }
 }

@@ -239,6 +239,123 @@ TEST(Cli, TrackIntoAnEarlierRunReplacesIt) {
   EXPECT_EQ(read_csv(dir / "out" / "estimates.csv").size(), 3u);  // header and frames 0, 1
 }
 
+std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
+  std::string out = text;
+  const auto at = out.find(from);
+  if (at != std::string::npos) out.replace(at, from.size(), to);
+  return out;
+}
+
+std::string hydrogel_config() {
+  std::ifstream in(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml");
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+const std::string kParams = " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + (fs::temp_directory_path() / "gtrack_cli_test" / "m.png").string();
+
+// A key or table that is missing points at the unread one it was likely
+// meant to be, with its line.
+TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
+  const std::string base = hydrogel_config();
+  const fs::path key = write("fxx.toml", replaced(base, "\nfx = ", "\nfxx = "));
+  CliRun r = gtrack("render -c " + key.string() + kParams);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("key 'sensor.fx': missing; expected a number > 0 (is 'fxx' on line "), std::string::npos)
+      << r.output;
+  const fs::path plugin = write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
+  r = gtrack("render -c " + plugin.string() + kParams);
+  EXPECT_NE(r.output.find("key 'gripper.plugin': missing"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(is 'plugn' on line "), std::string::npos) << r.output;
+  const fs::path table = write("sensr.toml", replaced(base, "[sensor]", "[sensr]"));
+  r = gtrack("render -c " + table.string() + kParams);
+  EXPECT_NE(r.output.find("missing table [sensor]"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(is 'sensr' on line "), std::string::npos) << r.output;
+  r = gtrack("render -c " + fs::temp_directory_path().string() + kParams);
+  EXPECT_NE(r.output.find(": is a folder; expected a TOML config file"), std::string::npos) << r.output;
+}
+
+// render checks the whole config, as track does, and where it will write
+// before it renders.
+TEST(Cli, RenderChecksTheConfigAndItsOutputsFirst) {
+  const fs::path cfg = write("trackr.toml", hydrogel_config() + "\n[trackr]\nparticles = 3\n");
+  CliRun r = gtrack("render -c " + cfg.string() + kParams);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("key 'trackr': unknown key at the top level (did you mean 'tracker'?)"), std::string::npos)
+      << r.output;
+  const fs::path ok = write("render_ok.toml", hydrogel_config());
+  r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o mask.jpgx");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("mask.jpgx: cannot write images of this kind"), std::string::npos) << r.output;
+  r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o no_such_folder/mask.png");
+  EXPECT_NE(r.output.find("the folder 'no_such_folder' does not exist"), std::string::npos) << r.output;
+}
+
+// A frame folder with a damaged image: the decoder's own words go into the
+// one line that names the file, not above it.
+TEST(Cli, ADamagedImageIsOneLineWithTheDecodersWords) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "damaged";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 6 --out " + dir.string()).code, 0);
+  const fs::path frame = dir / "frames" / "000001.png";
+  std::string bytes;
+  {
+    std::ifstream in(frame, std::ios::binary);
+    bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  std::ofstream(frame, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 3);
+  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                          " --no-overlay --log-level warn -o " + (dir / "out").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(frame.string() + ": cannot read the image"), std::string::npos) << r.output;
+}
+
+TEST(Cli, AFrameRangeOutsideTheInputIsAnError) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "range";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 6 --out " + dir.string()).code, 0);
+  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                          " --no-overlay --frames 20:30 -o " + (dir / "out").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("holds 3 frames, none of them in --frames 20:30"), std::string::npos) << r.output;
+}
+
+// eval reads its tables strictly: what it cannot read is named, with the
+// file and line, instead of being skipped.
+TEST(Cli, EvalRefusesMalformedTables) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_strict";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 6 --out " + dir.string()).code, 0);
+  std::ifstream in(dir / "ground_truth.csv");
+  std::vector<std::string> rows;
+  for (std::string l; std::getline(in, l);) rows.push_back(l);
+  ASSERT_EQ(rows.size(), 4u);
+  const auto table = [&](const std::string& name, const std::vector<std::string>& r) {
+    std::string text;
+    for (const auto& l : r) text += l + "\n";
+    return write(name, text);
+  };
+  const fs::path truth = dir / "ground_truth.csv";
+  const auto eval = [&](const fs::path& t, const fs::path& e) {
+    return gtrack("eval -c " + (dir / "sequence.toml").string() + " -t " + t.string() + " -e " + e.string());
+  };
+  CliRun r = eval(truth, table("twice.csv", {rows[0], rows[1], rows[2], rows[1]}));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("twice.csv:4: frame 0 again (first at line 2)"), std::string::npos) << r.output;
+  r = eval(table("in_view.csv", {rows[0], replaced(rows[1], ",1.0000,", ",abc,"), rows[2]}), truth);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("in_view.csv:2: expected a number for 'visible', got 'abc'"), std::string::npos)
+      << r.output;
+  r = eval(truth, table("wide.csv", {rows[0], rows[1] + ",7"}));
+  EXPECT_NE(r.output.find("wide.csv:2: expected 16 columns, got 17"), std::string::npos) << r.output;
+  r = eval(truth, table("header_only.csv", {rows[0]}));
+  EXPECT_NE(r.output.find("header_only.csv: a header and no rows"), std::string::npos) << r.output;
+  r = eval(dir / "no_such.csv", truth);
+  EXPECT_NE(r.output.find("no_such.csv: no such file"), std::string::npos) << r.output;
+}
+
 TEST(Cli, UsageErrors) {
   EXPECT_EQ(gtrack("rendr").code, 2);
   EXPECT_EQ(gtrack("render").code, 2);

@@ -99,7 +99,7 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   std::string typo = kFourFinger;
   typo.replace(typo.find("direction_deg = 45"), 18, "directon_deg = 45");
   const std::string e = config_error(typo);
-  EXPECT_NE(e.find("is 'directon_deg' a misspelling of it?"), std::string::npos) << e;
+  EXPECT_NE(e.find("is 'directon_deg' on line 7 a misspelling of it?"), std::string::npos) << e;
   // No fingers at all.
   EXPECT_NE(config_error("plugin = \"data_defined\"\npalm_mm = [[1,0],[0,1],[-1,0]]\n").find("finger"),
             std::string::npos);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -84,11 +85,15 @@ size_t edit_distance(std::string_view a, std::string_view b) {
 
 std::optional<std::string> closest_match(std::string_view word, const std::vector<std::string>& candidates) {
   std::optional<std::string> best;
-  size_t best_d = std::max<size_t>(2, word.size() / 3) + 1;
+  // Twice the edit distance, plus one when the first letter differs: of two
+  // equally close candidates, the one that starts like the word wins
+  // ('fxx' over 'cx' for 'fx'; a typo rarely hits the first letter).
+  size_t best_score = 2 * (std::max<size_t>(2, word.size() / 3) + 1);
   for (const auto& c : candidates) {
-    size_t d = edit_distance(word, c);
-    if (d < best_d) {
-      best_d = d;
+    const size_t d = edit_distance(word, c);
+    const size_t score = 2 * d + ((c.empty() || word.empty() || c[0] != word[0]) ? 1 : 0);
+    if (score < best_score) {
+      best_score = score;
       best = c;
     }
   }
@@ -108,6 +113,12 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
   } catch (const toml::parse_error& e) {
     std::ostringstream s;
     s << source << ":" << e.source().begin.line << ": " << e.description();
+    // A bare word after '=' is read as the start of a boolean or a number.
+    const std::string_view d = e.description();
+    if (d.find("parsing boolean") != std::string_view::npos ||
+        d.find("could not determine value type") != std::string_view::npos) {
+      s << " (a text value needs quotes: key = \"text\")";
+    }
     throw ConfigError(s.str());
   }
   impl->table = impl->root.get();
@@ -117,6 +128,8 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
 }
 
 ConfigTable ConfigTable::load_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a folder; expected a TOML config file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot open config file (does it exist and is it readable?)");
   std::ostringstream s;
@@ -166,15 +179,8 @@ void ConfigTable::mark_used(std::string_view key) const { impl_->used->insert(st
 namespace {
 // "missing; expected X", plus the likely misspelling when the table has an
 // unread key close to the one asked for.
-std::string missing_message(const ConfigTable::Impl& impl, std::string_view key, const std::string& expected) {
-  std::string msg = "missing; " + expected;
-  if (!impl.table) return msg;
-  std::vector<std::string> unread;
-  for (auto&& [k, v] : *impl.table) {
-    if (!impl.used->count(std::string(k.str()))) unread.emplace_back(k.str());
-  }
-  if (auto m = closest_match(key, unread)) msg += " (is '" + *m + "' a misspelling of it?)";
-  return msg;
+std::string missing_message(const ConfigTable& table, std::string_view key, const std::string& expected) {
+  return "missing; " + expected + table.misspelling_hint(key);
 }
 
 const toml::node* lookup(const ConfigTable::Impl& impl, std::string_view key) {
@@ -185,7 +191,7 @@ const toml::node* lookup(const ConfigTable::Impl& impl, std::string_view key) {
 
 double ConfigTable::number(std::string_view key, Range range) const {
   const toml::node* n = lookup(*impl_, key);
-  if (!n) fail(key, missing_message(*impl_, key, "expected " + describe_range(range)));
+  if (!n) fail(key, missing_message(*this, key, "expected " + describe_range(range)));
   auto v = as_number(*n);
   if (!v) fail(key, std::string("expected ") + describe_range(range) + ", got " + type_name(*n));
   if (!in_range(*v, range)) {
@@ -206,7 +212,7 @@ double ConfigTable::number_or(std::string_view key, double fallback, Range range
 
 long long ConfigTable::integer(std::string_view key, Range range) const {
   const toml::node* n = lookup(*impl_, key);
-  if (!n) fail(key, missing_message(*impl_, key, "expected an integer"));
+  if (!n) fail(key, missing_message(*this, key, "expected an integer"));
   auto v = n->value_exact<int64_t>();
   if (!v) fail(key, std::string("expected an integer, got ") + type_name(*n));
   if (!in_range(static_cast<double>(*v), range)) {
@@ -235,7 +241,7 @@ bool ConfigTable::boolean_or(std::string_view key, bool fallback) const {
 
 std::string ConfigTable::string(std::string_view key) const {
   const toml::node* n = lookup(*impl_, key);
-  if (!n) fail(key, missing_message(*impl_, key, "expected a string"));
+  if (!n) fail(key, missing_message(*this, key, "expected a string"));
   auto v = n->value_exact<std::string>();
   if (!v) fail(key, std::string("expected a string, got ") + type_name(*n));
   return *v;
@@ -265,7 +271,7 @@ std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
 std::vector<double> ConfigTable::numbers(std::string_view key, std::optional<size_t> size, Range range) const {
   const toml::node* n = lookup(*impl_, key);
   std::string expected = size ? "an array of " + std::to_string(*size) + " numbers" : std::string("an array of numbers");
-  if (!n) fail(key, missing_message(*impl_, key, "expected " + expected));
+  if (!n) fail(key, missing_message(*this, key, "expected " + expected));
   const toml::array* arr = n->as_array();
   if (!arr) fail(key, "expected " + expected + ", got " + type_name(*n));
   if (size && arr->size() != *size) {
@@ -297,7 +303,7 @@ std::vector<double> ConfigTable::numbers_or(std::string_view key, std::vector<do
 std::vector<std::vector<double>> ConfigTable::number_rows(std::string_view key, size_t row_size, Range range) const {
   const toml::node* n = lookup(*impl_, key);
   const std::string expected = "an array of [" + std::to_string(row_size) + " numbers] arrays";
-  if (!n) fail(key, missing_message(*impl_, key, "expected " + expected));
+  if (!n) fail(key, missing_message(*this, key, "expected " + expected));
   const toml::array* arr = n->as_array();
   if (!arr) fail(key, "expected " + expected + ", got " + type_name(*n));
   std::vector<std::vector<double>> out;
@@ -332,6 +338,18 @@ std::vector<std::string> ConfigTable::strings_or(std::string_view key, std::vect
     out.push_back(*v);
   }
   return out;
+}
+
+std::string ConfigTable::misspelling_hint(std::string_view key) const {
+  if (!impl_->table) return {};
+  std::vector<std::string> unread;
+  for (auto&& [k, v] : *impl_->table) {
+    if (!impl_->used->count(std::string(k.str())) && k.str() != key) unread.emplace_back(k.str());
+  }
+  const auto m = closest_match(key, unread);
+  if (!m) return {};
+  const toml::node* n = impl_->table->get(*m);
+  return " (is '" + *m + "' on line " + std::to_string(n ? n->source().begin.line : 0) + " a misspelling of it?)";
 }
 
 ConfigTable ConfigTable::table(std::string_view key) const {

@@ -1,6 +1,7 @@
 // The one logger of the process, shared with every plugin.
 #include "gtrack/log.hpp"
 
+#include <opencv2/core/utils/logger.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include "gtrack/error.hpp"
@@ -23,6 +24,12 @@ void set_log_level(std::string_view level) {
                 "'; expected one of trace, debug, info, warn, error, critical, off");
   }
   logger().set_level(lvl);
+  // OpenCV's own messages (a camera backend probing, a codec's warnings)
+  // show only when gtrack's are asked for at debug level or finer.
+  namespace cvlog = cv::utils::logging;
+  cvlog::setLogLevel(lvl <= spdlog::level::debug ? cvlog::LOG_LEVEL_INFO
+                     : lvl == spdlog::level::off ? cvlog::LOG_LEVEL_SILENT
+                                                 : cvlog::LOG_LEVEL_ERROR);
 }
 
 }  // namespace gtrack

@@ -3,8 +3,11 @@
 
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "gtrack/error.hpp"
@@ -103,14 +106,32 @@ fs::path data_dir() {
   return prefix_dir() / "share" / "gtrack";
 }
 
+namespace {
+
+// A folder named for plugins that is not there is most likely a typo: said
+// once per folder, and the search goes on without it.
+void warn_if_missing(const fs::path& dir, const char* from) {
+  static std::set<std::string> warned;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec) && warned.insert(dir.string()).second) {
+    logger().warn("plugin folder {} ({}) does not exist", dir.string(), from);
+  }
+}
+
+}  // namespace
+
 PluginLoader::PluginLoader(std::vector<fs::path> user_paths) : initial_user_(std::move(user_paths)) {
+  for (const auto& p : initial_user_) warn_if_missing(p, "--plugin-path");
   if (const char* env = std::getenv("GTRACK_PLUGIN_PATH"); env && *env) {
     std::string s = env;
     size_t start = 0;
     while (start <= s.size()) {
       size_t colon = s.find(':', start);
       if (colon == std::string::npos) colon = s.size();
-      if (colon > start) env_paths_.emplace_back(s.substr(start, colon - start));
+      if (colon > start) {
+        env_paths_.emplace_back(s.substr(start, colon - start));
+        warn_if_missing(env_paths_.back(), "GTRACK_PLUGIN_PATH");
+      }
       start = colon + 1;
     }
   }
@@ -118,6 +139,7 @@ PluginLoader::PluginLoader(std::vector<fs::path> user_paths) : initial_user_(std
 }
 
 void PluginLoader::add_path(const fs::path& dir) {
+  warn_if_missing(dir, "plugin_path");
   user_.push_back(dir);
   rebuild();
 }
@@ -168,6 +190,14 @@ std::vector<PluginRecord> PluginLoader::discover() const {
 }
 
 fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
+  // A name is a file name part, never a path.
+  const bool word = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '_' || c == '-' || c == '.';
+  }) && name.find("..") == std::string::npos;
+  if (!word) {
+    throw PluginError(std::string(to_string(kind)) + " plugin name '" + name +
+                      "': expected letters, digits, '_', '-' or '.' (a name, not a path; use plugin_path for folders)");
+  }
   for (const auto& dir : paths_) {
     fs::path f = dir / library_file_name(name);
     std::error_code ec;
@@ -228,10 +258,18 @@ template <class Interface>
 std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
   constexpr PluginKind kind = PluginTraits<Interface>::kind;
   if (!table.has("plugin")) {
-    table.fail("plugin", std::string("missing; [") + table.path() + "] must name a " + to_string(kind) + " plugin");
+    table.fail("plugin", std::string("missing; [") + table.path() + "] must name a " + to_string(kind) + " plugin" +
+                             table.misspelling_hint("plugin"));
   }
   const std::string name = table.string("plugin");
-  return make_from_file<Interface>(find(kind, name), name, table);
+  fs::path file;
+  try {
+    file = find(kind, name);
+  } catch (const PluginError& e) {
+    // Where the config names the plugin, ahead of what is wrong with it.
+    throw PluginError(table.where("plugin") + ": " + e.what());
+  }
+  return make_from_file<Interface>(file, name, table);
 }
 
 std::shared_ptr<Sensor> PluginLoader::make_sensor(const ConfigTable& t) const { return make<Sensor>(t); }

@@ -19,12 +19,16 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   }
   s.loader = loader;
   for (const char* t : {"sensor", "gripper"}) {
-    if (!root.has(t)) root.fail(t, std::string("missing table [") + t + "]; it must name a " + t + " plugin");
+    if (!root.has(t)) {
+      root.fail(t, std::string("missing table [") + t + "]; it must name a " + t + " plugin" + root.misspelling_hint(t));
+    }
   }
   s.sensor = loader->make_sensor(root.table("sensor"));
   s.gripper = loader->make_gripper(root.table("gripper"));
   if (options.with_stimulus) {
-    if (!root.has("stimulus")) root.fail("stimulus", "missing table [stimulus]; it must name a stimulus plugin");
+    if (!root.has("stimulus")) {
+      root.fail("stimulus", "missing table [stimulus]; it must name a stimulus plugin" + root.misspelling_hint("stimulus"));
+    }
     s.stimulus = loader->make_stimulus(root.table("stimulus"));
   } else {
     root.mark_used("stimulus");

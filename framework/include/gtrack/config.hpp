@@ -78,6 +78,10 @@ class GTRACK_API ConfigTable {
   // for a likely misspelling among the keys that were read.
   void check_all_used() const;
 
+  // For a key that is missing: " (is 'k2' on line N a misspelling of it?)"
+  // when the table has a key nothing read that is close to it, else "".
+  std::string misspelling_hint(std::string_view key) const;
+
   // "file:line: [path] key 'k'": where a key is, for messages of callers.
   std::string where(std::string_view key) const;
   // The file this table came from ("" if none).

@@ -67,12 +67,13 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
   }
 
   int line_no = 1;
+  std::map<int, int> first_line;  // frame -> the line it is on
   while (std::getline(in, line)) {
     ++line_no;
     if (line.empty() || line == "\r") continue;
     const auto cells = split_csv(line);
     const auto where = file.string() + ":" + std::to_string(line_no) + ": ";
-    if (cells.size() < header.size()) {
+    if (cells.size() != header.size()) {
       throw InputError(where + "expected " + std::to_string(header.size()) + " columns, got " +
                        std::to_string(cells.size()));
     }
@@ -88,9 +89,24 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
         throw InputError(where + "expected a number for '" + names[d + 1] + "', got '" + cells[idx[d + 1]] + "'");
       }
     }
-    if (status_col >= 0) row.status = cells[status_col];
+    if (status_col >= 0) {
+      row.status = cells[status_col];
+      if (row.status != "ok" && row.status != "search" && row.status != "lost") {
+        throw InputError(where + "expected a status of ok, search or lost, got '" + row.status + "'");
+      }
+    }
     for (size_t e = 0; e < extra_idx.size(); ++e) {
-      if (parse_number(cells[extra_idx[e]], v)) row.extra[table.extra_columns[e]] = v;
+      const std::string& cell = cells[extra_idx[e]];
+      if (cell.empty()) continue;
+      if (!parse_number(cell, v)) {
+        throw InputError(where + "expected a number for '" + table.extra_columns[e] + "', got '" + cell + "'");
+      }
+      row.extra[table.extra_columns[e]] = v;
+    }
+    const auto [first, fresh] = first_line.emplace(row.frame, line_no);
+    if (!fresh) {
+      throw InputError(where + "frame " + std::to_string(row.frame) + " again (first at line " +
+                       std::to_string(first->second) + ")");
     }
     table.rows.push_back(std::move(row));
   }

@@ -8,7 +8,9 @@
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
 
+#include "captured_stderr.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 
 namespace gtrack {
 
@@ -104,6 +106,35 @@ class VideoSource final : public FrameSource {
   int delivered_ = 0;
 };
 
+// Name order with runs of digits compared as numbers ("img2" < "img10");
+// equal values with more leading zeros, and otherwise equal names, fall back
+// to plain order so that the order is total.
+bool natural_less(const std::string& a, const std::string& b) {
+  size_t i = 0, j = 0;
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  while (i < a.size() && j < b.size()) {
+    if (digit(a[i]) && digit(b[j])) {
+      size_t ie = i, je = j;
+      while (ie < a.size() && digit(a[ie])) ++ie;
+      while (je < b.size() && digit(b[je])) ++je;
+      size_t is = i, js = j;
+      while (is + 1 < ie && a[is] == '0') ++is;
+      while (js + 1 < je && b[js] == '0') ++js;
+      if (ie - is != je - js) return ie - is < je - js;
+      const int c = a.compare(is, ie - is, b, js, je - js);
+      if (c != 0) return c < 0;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  if ((i < a.size()) != (j < b.size())) return j < b.size();
+  return a < b;
+}
+
 class FolderSource final : public FrameSource {
  public:
   FolderSource(const fs::path& dir, ImageSize expected, FrameRange range, double fps)
@@ -115,7 +146,9 @@ class FolderSource final : public FrameSource {
       std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
       if (std::find(exts.begin(), exts.end(), ext) != exts.end()) files_.push_back(e.path());
     }
-    std::sort(files_.begin(), files_.end());
+    // Numbers in names compare by value: frame9.png before frame10.png.
+    std::sort(files_.begin(), files_.end(),
+              [](const fs::path& a, const fs::path& b) { return natural_less(a.filename().string(), b.filename().string()); });
     if (files_.empty()) {
       throw InputError(dir.string() + ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm)");
     }
@@ -127,8 +160,14 @@ class FolderSource final : public FrameSource {
       const int i = index_++;
       if (!filter_.wanted(i)) continue;
       const fs::path& p = files_[static_cast<size_t>(i)];
+      detail::CapturedStderr library;
       cv::Mat img = cv::imread(p.string(), cv::IMREAD_COLOR);
-      if (img.empty()) throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format)");
+      const std::string said = library.take();
+      if (img.empty()) {
+        throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format" +
+                         (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
+      }
+      if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
       Frame f;
       f.index = i;
       f.time_s = fps_ > 0 ? i / fps_ : 0.0;
@@ -187,7 +226,10 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
     if (n.empty() || ec != std::errc() || end != n.data() + n.size() || dev < 0) {
       throw InputError("'" + spec + "': expected camera:N with N a device number");
     }
+    detail::CapturedStderr library;
     cv::VideoCapture cap(dev);
+    const std::string said = library.take();
+    if (!said.empty()) logger().debug("'{}': the capture backends said: {}", spec, said);
     if (!cap.isOpened()) throw InputError("'" + spec + "': cannot open camera device " + n);
     cap.set(cv::CAP_PROP_FRAME_WIDTH, expected.width);
     cap.set(cv::CAP_PROP_FRAME_HEIGHT, expected.height);
@@ -201,9 +243,14 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   // FFmpeg alone when it is there: the other backends print pages of
   // warnings for an undecodable file, and the error below says it in a line.
   const bool ffmpeg = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG);
-  if (!cap.open(spec, ffmpeg ? cv::CAP_FFMPEG : cv::CAP_ANY) || !cap.isOpened()) {
-    throw InputError(spec + ": cannot open as a video (corrupt or unsupported format)");
+  detail::CapturedStderr library;
+  const bool opened = cap.open(spec, ffmpeg ? cv::CAP_FFMPEG : cv::CAP_ANY) && cap.isOpened();
+  const std::string said = library.take();
+  if (!opened) {
+    throw InputError(spec + ": cannot open as a video (corrupt or unsupported format" +
+                     (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
   }
+  if (!said.empty()) logger().debug("{}: the decoder said: {}", spec, said);
   return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, false);
 }
 

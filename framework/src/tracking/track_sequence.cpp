@@ -156,6 +156,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
                                   config.tracker.fps > 0 ? config.tracker.fps : 30.0);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
+  if (!resumed && expected_frames(*source, range) == 0) {
+    throw InputError(options.input + ": holds " + std::to_string(source->frame_count()) +
+                     " frames, none of them in --frames " + std::to_string(range.first) + ":" +
+                     (range.last >= 0 ? std::to_string(range.last) : std::string()));
+  }
 
   // The reading of a frame: the log's, or its nearest past the log's ends.
   bool warned_range = false;
@@ -288,7 +293,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
   summary.wall_s = seconds_since(start);
   summary.overlay_file = overlay.file();
-  write_summary(options.out_dir / "summary.json", summary);
+  // Resuming a finished run tracks nothing: its summary stays as it was.
+  if (!(resumed && summary.frames == 0)) write_summary(options.out_dir / "summary.json", summary);
   return summary;
 }
 
