@@ -347,6 +347,35 @@ TEST(GlRenderer, ABatchAfterALargerOneSeesNothingOfIt) {
   }
 }
 
+// The count pass is built with the rows per invocation the device wants
+// (255 on llvmpipe, 32 on a GPU): every choice counts the same.
+TEST(GlRenderer, CountsAreTheSameForAnyRowsPerInvocation) {
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(70, 8, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(6));
+  auto cpu = make_cpu();
+  cpu->set_model(s.model);
+  cpu->set_projection(s.projection, kScale);
+  cpu->set_observation(s.observation);
+  std::vector<PairCounts> want, got;
+  cpu->evaluate(H, want);
+  for (const char* rows : {"1", "7", "32", "255"}) {
+    ScopedEnv env("GTRACK_GL_COUNT_ROWS", rows);
+    GL_OR_SKIP(gl);
+    gl->set_model(s.model);
+    gl->set_projection(s.projection, kScale);
+    gl->set_observation(s.observation);
+    gl->evaluate(H, got);
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t i = 0; i < got.size(); ++i) {
+      EXPECT_TRUE(counts_agree(got[i].rendered, want[i].rendered)) << rows << " rows, hypothesis " << i;
+      EXPECT_TRUE(counts_agree(got[i].intersection, want[i].intersection)) << rows << " rows, hypothesis " << i;
+    }
+  }
+  ScopedEnv bad("GTRACK_GL_COUNT_ROWS", "256");
+  EXPECT_THROW(gtrack::make_gl_renderer({}), gtrack::Error);
+}
+
 TEST(GlRenderer, SubmitReturnsAndFinishCollects) {
   GL_OR_SKIP(gl);
   Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <string>
@@ -20,7 +21,27 @@ namespace {
 
 constexpr int kLayerBits = 32;         // hypotheses per R32UI layer
 constexpr int kCountGroupWidth = 32;   // columns per count workgroup
-constexpr int kCountRows = 255;        // rows per count invocation: the most count.comp allows
+constexpr int kMaxCountRows = 255;     // rows per count invocation: the most count.comp allows
+static_assert(kCountGroupWidth >= 32, "count.comp clears and sums 32 shared counters with one invocation each");
+static_assert(kMaxCountRows * kCountGroupWidth <= 0xFFFF, "a workgroup's counts must fit the 16-bit halves");
+
+// Rows per count invocation. A CPU driver (llvmpipe) runs few threads and
+// wants long columns; a GPU wants many short ones to fill its cores.
+// GTRACK_GL_COUNT_ROWS (1-255) overrides the choice, for tuning on a device.
+int count_rows_for(const std::string& renderer) {
+  if (const char* env = std::getenv("GTRACK_GL_COUNT_ROWS"); env && *env) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (*end != '\0' || v < 1 || v > kMaxCountRows) {
+      throw Error(std::string("GTRACK_GL_COUNT_ROWS='") + env + "': expected a whole number from 1 to " +
+                  std::to_string(kMaxCountRows));
+    }
+    return static_cast<int>(v);
+  }
+  const bool cpu = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos ||
+                   renderer.find("SwiftShader") != std::string::npos;
+  return cpu ? kMaxCountRows : 32;
+}
 constexpr int kMaxClipPlanes = 4;
 
 // Binding points shared with the shaders.
@@ -42,12 +63,12 @@ void delete_buffer(const Api& gl, GLuint& b) {
   b = 0;
 }
 
-std::string prelude(const std::string& layer_extension) {
+std::string prelude(const std::string& layer_extension, int count_rows) {
   std::string p = "#version 450 core\n";
   if (!layer_extension.empty()) p += "#extension " + layer_extension + " : require\n";
   p += "#define MAX_CLIP_PLANES " + std::to_string(kMaxClipPlanes) + "\n";
   p += "#define COUNT_GROUP_WIDTH " + std::to_string(kCountGroupWidth) + "\n";
-  p += "#define COUNT_ROWS " + std::to_string(kCountRows) + "\n";
+  p += "#define COUNT_ROWS " + std::to_string(count_rows) + "\n";
   return p;
 }
 
@@ -85,7 +106,8 @@ GlRenderer::GlRenderer(const RenderOptions& options)
                 "vertex shader)");
   }
 
-  const std::string head = prelude(layer_extension);
+  count_rows_ = count_rows_for(context_.gl_renderer());
+  const std::string head = prelude(layer_extension, count_rows_);
   draw_program_ = build_program(gl_, head, {{GL_VERTEX_SHADER, {"pose.glsl", "hypotheses.vert"}},
                                             {GL_FRAGMENT_SHADER, {"hypotheses.frag"}}});
   try {
@@ -376,7 +398,7 @@ void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
     gl_.UseProgram(count_program_);
     gl_.ProgramUniform1i(count_program_, u_hypotheses_, n);
     gl_.DispatchCompute(GLuint((max_w + kCountGroupWidth - 1) / kCountGroupWidth),
-                        GLuint((max_h + kCountRows - 1) / kCountRows), GLuint(layers));
+                        GLuint((max_h + count_rows_ - 1) / count_rows_), GLuint(layers));
   }
   gl_.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   gl_.CopyNamedBufferSubData(count_buffer_, readback_buffer_, 0, 0, count_bytes);

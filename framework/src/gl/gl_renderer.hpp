@@ -67,6 +67,7 @@ class GlRenderer final : public Renderer {
   int hypothesis_capacity_ = 0;
   int layer_capacity_ = 0;  // layers of target_: at least those of the largest batch so far
   int max_clip_planes_ = 0;
+  int count_rows_ = 0;  // rows per count invocation (COUNT_ROWS of count.comp)
 
   int dims_ = 0;
   int vertices_ = 0;
