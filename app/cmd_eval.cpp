@@ -84,7 +84,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   const auto ev = gtrack::evaluate(setup.model(), truth, estimates, opt, setup.sensor.get());
 
   std::cout << "frames " << ev.frames << ": " << ev.in_view_frames << " in view (" << ev.evaluated_frames
-            << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames << " off track), "
+            << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames << " off track: endpoints > " << opt.off_track_endpoint_um << " um in 3D), "
             << ev.out_of_view_frames << " out of view; lost in all " << ev.lost_frames << " (missing "
             << ev.missing_frames << ")\n";
   if (ev.evaluated_frames == 0) {
