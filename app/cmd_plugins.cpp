@@ -8,15 +8,15 @@ namespace {
 
 int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_options::variables_map& vm) {
   gtrack::PluginLoader loader(common.plugin_paths);
-  const auto records = loader.discover();
-  if (vm.count("paths")) {
+  if (vm.count("paths")) {  // the folders alone: no plugin is opened
     for (const auto& p : loader.search_paths()) std::cout << p.string() << "\n";
     return 0;
   }
+  const auto records = loader.discover();
   if (records.empty()) {
-    std::cerr << "gtrack: no plugins found in: ";
-    for (const auto& p : loader.search_paths()) std::cerr << p.string() << " ";
-    std::cerr << "\n";
+    std::string where;
+    for (const auto& p : loader.search_paths()) where += (where.empty() ? "" : ", ") + p.string();
+    std::cerr << "gtrack: error: no plugins found in: " << where << "\n";
     return 1;
   }
   for (const auto& r : records) {
