@@ -30,7 +30,7 @@ struct Command {
   // Runs with the parsed options; returns the process exit code.
   std::function<int(const CommonOptions&, const boost::program_options::variables_map&)> run;
   // Positional arguments, if the command takes any.
-  std::vector<std::string> positional;
+  std::vector<std::string> positional = {};
 };
 
 std::vector<Command>& registry();
