@@ -65,6 +65,15 @@ TEST(DataDefinedGripper, RadialFormAndModelFile) {
       "link_lengths_mm = [0.2, 0.2, 0.2]\nlink_widths_mm = [0.3, 0.25, 0.2, 0]\n");
   EXPECT_EQ(g->model().fingers(), 5);
   EXPECT_EQ(g->model().triangles(), 3 + 5 * 5);
+  // A radial gripper looks the same after a turn by one finger.
+  EXPECT_EQ(g->model().geometry().symmetry_order, 5);
+  // Two fingers need a palm with a multiple of two sides: a square by default.
+  auto two = make_gripper(
+      "plugin = \"data_defined\"\n[radial]\nfingers = 2\npalm_circumradius_mm = 0.3\n"
+      "link_lengths_mm = [0.2]\nlink_widths_mm = [0.2, 0.1]\n");
+  EXPECT_EQ(two->model().fingers(), 2);
+  EXPECT_EQ(two->model().geometry().palm_mm.size(), 4u);
+  EXPECT_EQ(two->model().geometry().symmetry_order, 2);
 
   const auto dir = std::filesystem::temp_directory_path() / "gtrack_data_defined_test";
   std::filesystem::create_directories(dir);

@@ -119,6 +119,15 @@ TEST(HydrogelModel, ConfigOverridesAreValidated) {
   EXPECT_THROW(make_gripper("plugin = \"hydrogel_six_finger\"\nlink_widths_mm = [1, 2]"), gtrack::ConfigError);
   EXPECT_THROW(make_gripper("plugin = \"hydrogel_six_finger\"\njoint_min_deg = 50\njoint_max_deg = 40"),
                gtrack::ConfigError);
+  // Another number of links needs its widths: the built-in ones are for four.
+  try {
+    make_gripper("plugin = \"hydrogel_six_finger\"\nlink_lengths_mm = [0.5, 0.5]");
+    ADD_FAILURE() << "two links without their widths were accepted";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'link_widths_mm': missing; link_lengths_mm gives 2 links"),
+              std::string::npos)
+        << e.what();
+  }
   auto g = make_gripper("plugin = \"hydrogel_six_finger\"\nlink_lengths_mm = [0.5, 0.5]\nlink_widths_mm = [0.5, 0.4, 0]");
   EXPECT_EQ(g->model().triangles(), 4 + 6 * 3);
 }

@@ -4,9 +4,10 @@
 // Photo-responsive hinges (e.g. a gold-nanorod-doped hydrogel) fold while the
 // irradiance is above `fold_above_mW_cm2` and relax below
 // `unfold_below_mW_cm2`. The log is the usual stimulus CSV with the
-// irradiance as its value column. S(H) and the swarm bias follow the same
-// rules as the temperature plugin: joints outside the band the light allows
-// are infeasible; folding is likely while the light is rising in the band.
+// irradiance as its value column. S(H) follows the temperature plugin's
+// rule: joints outside the band the light allows are infeasible. The swarm
+// bias is simpler: while the light is in the band and rising (by more than
+// `trend_threshold_mW_cm2_per_s`), most particles start more folded.
 #include <algorithm>
 #include <cmath>
 #include <gtrack/plugin.hpp>
@@ -22,7 +23,9 @@ class LightIntensity final : public gtrack::Stimulus {
     unfolded_ = t.number_or("unfolded_deg", 0.0);
     folded_ = t.number_or("folded_deg", 50.0);
     tolerance_ = t.number_or("tolerance_deg", 8.0, Range::non_negative());
+    threshold_ = t.number_or("trend_threshold_mW_cm2_per_s", 1.0, Range::non_negative());
     if (!(unfold_below_ < fold_above_)) t.fail("fold_above_mW_cm2", "must be greater than unfold_below_mW_cm2");
+    if (folded_ == unfolded_) t.fail("folded_deg", "must differ from unfolded_deg");
   }
 
   void update(double value, double time_s) override {
@@ -37,9 +40,9 @@ class LightIntensity final : public gtrack::Stimulus {
     gtrack::StimulusState s;
     s.value = value_;
     s.rate = rate_;
-    s.trend = rate_ > 0 ? gtrack::StimulusTrend::Folding
-              : rate_ < 0 ? gtrack::StimulusTrend::Unfolding
-                          : gtrack::StimulusTrend::Steady;
+    s.trend = rate_ > threshold_ ? gtrack::StimulusTrend::Folding
+              : rate_ < -threshold_ ? gtrack::StimulusTrend::Unfolding
+                                    : gtrack::StimulusTrend::Steady;
     s.in_transition = value_ > unfold_below_ && value_ < fold_above_;
     const double ref = value_ >= fold_above_ ? folded_ : unfolded_;
     if (s.in_transition) {
@@ -63,10 +66,14 @@ class LightIntensity final : public gtrack::Stimulus {
     return n ? sum / n / std::abs(folded_ - unfolded_) : 0.0;
   }
 
+  // Share of the swarm whose joints start increased: towards folded_deg
+  // while folding, whichever way that is.
   double fold_fraction() const override {
     const auto s = state();
-    if (!s.in_transition) return 0.5;
-    return rate_ > 0 ? 0.75 : rate_ < 0 ? 0.25 : 0.5;
+    if (!s.in_transition || s.trend == gtrack::StimulusTrend::Steady) return 0.5;
+    const bool towards_folded = s.trend == gtrack::StimulusTrend::Folding;
+    const bool folding_increases = folded_ > unfolded_;
+    return towards_folded == folding_increases ? 0.75 : 0.25;
   }
 
   double target_joint_deg(double current) const override {
@@ -79,7 +86,7 @@ class LightIntensity final : public gtrack::Stimulus {
   std::string reading_unit() const override { return "mW/cm2"; }
 
  private:
-  double unfold_below_, fold_above_, unfolded_, folded_, tolerance_;
+  double unfold_below_, fold_above_, unfolded_, folded_, tolerance_, threshold_;
   double value_ = 0, rate_ = 0, t_ = 0;
   bool have_ = false;
 };

@@ -1,6 +1,7 @@
 // three_finger_gripper: a compiled gripper plugin from outside the gtrack tree.
 //
-// A triangular palm with one three-link finger per edge, 2 mm tip to tip.
+// A triangular palm with one three-link finger per edge; open, its tips lie
+// on a circle 2 mm across (1.73 mm from one tip to the next).
 // Dimensions can be overridden from the [gripper] table with the keys every
 // radial gripper understands (see docs/plugins.md).
 #include <gtrack/gripper_config.hpp>
@@ -28,4 +29,4 @@ using ThreeFingerGripper = gtrack::RadialGripper<three_finger_defaults>;
 }  // namespace
 
 GTRACK_PLUGIN(ThreeFingerGripper, gtrack::Gripper, "three_finger_gripper", "0.1.0",
-              "example: triangular palm, 3 fingers x 3 links, 2 mm tip to tip")
+              "example: triangular palm, 3 fingers x 3 links, tips on a 2 mm circle")

@@ -13,6 +13,13 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
   lengths = t.numbers_or("link_lengths_mm", lengths, std::nullopt, Range::positive());
   if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
   const bool lengths_changed = lengths.size() != d.widths_mm.size() - 1;
+  // The built-in widths fit the built-in number of links only.
+  if (lengths_changed && !t.has("link_widths_mm")) {
+    t.fail("link_widths_mm", "missing; link_lengths_mm gives " + std::to_string(lengths.size()) +
+                                 " links, so the widths at their " + std::to_string(lengths.size() + 1) +
+                                 " ends are needed (the built-in ones are for " +
+                                 std::to_string(d.widths_mm.size() - 1) + " links)");
+  }
   std::vector<double> widths = t.numbers_or("link_widths_mm", lengths_changed ? std::vector<double>{} : d.widths_mm,
                                             lengths.size() + 1, Range::non_negative());
   spec.links.clear();

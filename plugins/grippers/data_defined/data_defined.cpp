@@ -42,7 +42,10 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
     gtrack::RadialGripperSpec spec;
     spec.name = name;
     spec.fingers = static_cast<int>(r.integer("fingers", Range{1, 64}));
-    spec.palm_sides = static_cast<int>(r.integer_or("palm_sides", std::max(3, spec.fingers), Range{3, 256}));
+    // By default one side per finger; two fingers get a square palm (the
+    // smallest polygon whose sides are a multiple of the fingers).
+    const int sides = spec.fingers * ((3 + spec.fingers - 1) / spec.fingers);
+    spec.palm_sides = static_cast<int>(r.integer_or("palm_sides", sides, Range{3, 256}));
     if (spec.palm_sides % spec.fingers != 0) r.fail("palm_sides", "must be a multiple of fingers");
     spec.palm_circumradius_mm = r.number("palm_circumradius_mm", Range::positive());
     spec.finger_phase_deg = r.number_or("phase_deg", 0.0);
@@ -84,7 +87,10 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   if (!(g.joint_min_deg < g.joint_max_deg)) t.fail("joint_max_deg", "must be greater than joint_min_deg");
   g.collision.max_difference_deg = t.number_or("max_adjacent_difference_deg", 45, Range::positive());
   g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", 1e9, Range::positive());
-  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", 1, Range{1, 64}));
+  // A radial gripper is symmetric under a turn by one finger; one drawn
+  // finger by finger is not, unless said so.
+  const int symmetry = t.has("radial") ? static_cast<int>(g.fingers.size()) : 1;
+  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", symmetry, Range{1, 64}));
   g.unfolded_deg = t.number_or("unfolded_deg", 0);
   g.folded_deg = t.number_or("folded_deg", 60);
   return g;
