@@ -350,6 +350,10 @@ TEST(Cli, EvalRefusesMalformedTables) {
       << r.output;
   r = eval(truth, table("wide.csv", {rows[0], rows[1] + ",7"}));
   EXPECT_NE(r.output.find("wide.csv:2: expected 16 columns, got 17"), std::string::npos) << r.output;
+  r = eval(truth, table("huge_frame.csv", {rows[0], "1e300" + rows[1].substr(1)}));
+  EXPECT_NE(r.output.find("huge_frame.csv:2: expected a frame index (a whole number from 0), got '1e300'"),
+            std::string::npos)
+      << r.output;
   r = eval(truth, table("header_only.csv", {rows[0]}));
   EXPECT_NE(r.output.find("header_only.csv: a header and no rows"), std::string::npos) << r.output;
   r = eval(dir / "no_such.csv", truth);

@@ -61,13 +61,13 @@ TEST(Regression, NonAsciiInCommentsAndStringsIsAccepted) {
   EXPECT_EQ(t.string("name"), "50 \xC2\xB5m");
 }
 
-// fuzz_stimulus_log (fuzz/known/stimulus_interpolation_overflow.csv): two
+// fuzz_stimulus_log (fuzz/crashes/stimulus_interpolation_overflow.csv): two
 // finite readings far apart (-1e308, 1e308) interpolate to +inf, because
 // value_at() computes v0 + a * (v1 - v0) and v1 - v0 overflows. An infinite
 // reading would reach the Stimulus plugin. Fixed in stimulus_log.cpp:
 // (1 - a) * v0 + a * v1, which stays finite for finite rows and a in [0, 1].
 TEST(Regression, StimulusInterpolationStaysFinite) {
-  const fs::path p = fs::path(GTRACK_TEST_SOURCE_DIR) / "fuzz" / "known" / "stimulus_interpolation_overflow.csv";
+  const fs::path p = fs::path(GTRACK_TEST_SOURCE_DIR) / "fuzz" / "crashes" / "stimulus_interpolation_overflow.csv";
   const auto log = gtrack::StimulusLog::load(p);
   const auto v = log.value_at(1, 1 / 30.0);
   ASSERT_TRUE(v);

@@ -79,8 +79,8 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
     }
     PoseRow row;
     double v = 0;
-    if (!parse_number(cells[idx[0]], v) || v != std::floor(v)) {
-      throw InputError(where + "expected an integer frame index, got '" + cells[idx[0]] + "'");
+    if (!parse_number(cells[idx[0]], v) || v != std::floor(v) || v < 0 || v > 2147483647.0) {
+      throw InputError(where + "expected a frame index (a whole number from 0), got '" + cells[idx[0]] + "'");
     }
     row.frame = static_cast<int>(v);
     row.h.resize(kPoseDims + table.fingers);
