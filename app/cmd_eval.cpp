@@ -78,7 +78,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     if (!truth_frames.count(r.frame)) unmatched.push_back(r.frame);
   }
   if (!unmatched.empty()) {
-    gtrack::logger().warn("{}: {} rows are of frames {} has no row for (the first is frame {}); they are not evaluated",
+    gtrack::logger().warn("{}: {} rows are for frames {} has no row for (the first: frame {}); they are not evaluated",
                           estimates_file.string(), unmatched.size(), truth_file.string(), unmatched.front());
   }
   const auto ev = gtrack::evaluate(setup.model(), truth, estimates, opt, setup.sensor.get());
