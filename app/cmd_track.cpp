@@ -57,6 +57,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.resume = vm.count("resume") > 0;
   opt.follow_stimulus = vm.count("follow-stimulus") > 0;
   if (vm.count("restart-from")) opt.restart_from = vm["restart-from"].as<std::string>();
+  if (vm.count("follow-input")) {
+    opt.follow_input_s = vm["follow-input"].as<double>();
+    if (!(opt.follow_input_s > 0)) throw gtrack::cli::UsageError("--follow-input: expected seconds > 0");
+  }
   // --stream: each estimate, as its estimates.jsonl line, on stdout as soon
   // as it is made (for a controller reading a pipe); the rest goes to stderr.
   const bool stream = vm.count("stream") > 0;
@@ -111,6 +115,9 @@ GTRACK_COMMAND(
           "resume", "continue the run whose files are in OUT after its last finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
           "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(
+          "follow-input", po::value<double>(),
+          "SECONDS: the input folder is still being written: track new images as they arrive, end after SECONDS "
+          "without one")(
           "restart-from", po::value<std::string>(),
           "pose table (e.g. ground_truth.csv): before each frame, set the track to its row for the previous frame");
     },

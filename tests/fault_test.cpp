@@ -6,6 +6,10 @@
 // finished before the fault present and well-formed in estimates.csv.
 // Runs are tiny (128x128 frames, N=8, G=2) so the whole file takes seconds.
 #include <gtest/gtest.h>
+#include <iterator>
+#include <chrono>
+#include <numeric>
+#include <thread>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -269,6 +273,57 @@ TEST(Fault, FollowedStimulusLogGivesEachFrameTheLatestReading) {
   for (int i = 2; i < kFrames; ++i) {
     ASSERT_TRUE(readings[i]) << "frame " << i;
     EXPECT_DOUBLE_EQ(*readings[i], 23.5 + (i - 2)) << "frame " << i;
+  }
+}
+
+// A folder that acquisition software is still writing (--follow-input):
+// images arrive while the run goes on, each first half written, with names
+// whose numbers are not padded. Every one is tracked, once, in the order of
+// its number, and the run ends on its own once no image has come for the
+// idle time.
+TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
+  const fs::path dir = fresh_dir("follow_input");
+  const fs::path staged = write_frames(dir / "staged", kFrames), live = dir / "live";
+  fs::create_directories(live);
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o;
+  o.input = live.string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  o.follow_input_s = 1.0;
+  std::thread writer([&] {
+    for (int i = 0; i < kFrames; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%06d.png", i);
+      std::ifstream in(staged / name, std::ios::binary);
+      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      const fs::path to = live / ("img" + std::to_string(i) + ".png");
+      std::ofstream(to, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+      std::this_thread::sleep_for(std::chrono::milliseconds(60));
+      std::ofstream(to, std::ios::binary | std::ios::trunc) << bytes;
+      std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    }
+  });
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  writer.join();
+  EXPECT_EQ(s.frames, kFrames);
+  std::vector<int> want(kFrames);
+  std::iota(want.begin(), want.end(), 0);
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), want);
+}
+
+TEST(Fault, OnlyAFolderCanBeFollowed) {
+  const fs::path dir = fresh_dir("follow_video");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, 2);
+  o.input = (dir / "frames" / "000000.png").string();
+  o.follow_input_s = 1.0;
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    FAIL() << "following a file was accepted";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_TRUE(one_line(e.what())) << e.what();
+    EXPECT_NE(std::string(e.what()).find("only a folder of images can be followed"), std::string::npos) << e.what();
   }
 }
 

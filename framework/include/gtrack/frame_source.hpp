@@ -8,6 +8,7 @@
 // skipped by `every` or outside the range, so results line up with the input.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -47,10 +48,25 @@ class GTRACK_API FrameSource {
   virtual std::string description() const = 0;
 };
 
+// A folder that acquisition software is still writing images into: once
+// the images there are tracked, the source waits for new ones (in name
+// order, after the last one taken) and ends when none has come for idle_s
+// seconds, or when *cancel is raised. An image that does not decode yet (it
+// is still being written) is read again for up to two seconds.
+struct FollowOptions {
+  double idle_s = 0;                          // 0: do not follow
+  const std::atomic<bool>* cancel = nullptr;  // raised: stop waiting
+};
+
 // Throws InputError for a missing or unreadable video, an empty folder, a
 // camera that does not open. `fallback_fps` times frames when the source has
 // no rate of its own.
 GTRACK_API std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSize expected,
                                                           FrameRange range, double fallback_fps);
+// The same; `follow` (idle_s > 0) follows a folder, and is refused for any
+// other input.
+GTRACK_API std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSize expected,
+                                                          FrameRange range, double fallback_fps,
+                                                          const FollowOptions& follow);
 
 }  // namespace gtrack

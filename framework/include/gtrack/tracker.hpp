@@ -141,6 +141,10 @@ struct TrackOptions {
   // The stimulus log is still being written (a live run): before each frame
   // its new rows are read, and the frame takes the last row's reading.
   bool follow_stimulus = false;
+  // The input folder is still being written (acquisition software saving
+  // images as they come): new images are tracked as they arrive, and the
+  // run ends after this many seconds without one (0: not followed).
+  double follow_input_s = 0;
   // A pose table (ground_truth.csv, or another run's estimates.csv): before
   // each frame the track is set to the table's row for the range's previous
   // frame, so each estimate is one frame of tracking from that row. With the

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <thread>
+#include <chrono>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -137,57 +139,112 @@ bool natural_less(const std::string& a, const std::string& b) {
 
 class FolderSource final : public FrameSource {
  public:
-  FolderSource(const fs::path& dir, ImageSize expected, FrameRange range, double fps)
-      : dir_(dir), expected_(expected), filter_(range), fps_(fps) {
-    static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
-    for (const auto& e : fs::directory_iterator(dir)) {
-      if (!e.is_regular_file()) continue;
-      std::string ext = e.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) files_.push_back(e.path());
-    }
-    // Numbers in names compare by value: frame9.png before frame10.png.
-    std::sort(files_.begin(), files_.end(),
-              [](const fs::path& a, const fs::path& b) { return natural_less(a.filename().string(), b.filename().string()); });
-    if (files_.empty()) {
+  FolderSource(const fs::path& dir, ImageSize expected, FrameRange range, double fps, FollowOptions follow)
+      : dir_(dir), expected_(expected), filter_(range), fps_(fps), follow_(follow) {
+    scan();
+    if (files_.empty() && !following()) {
       throw InputError(dir.string() + ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm)");
     }
   }
 
   std::optional<Frame> next() override {
-    while (index_ < static_cast<int>(files_.size())) {
-      if (filter_.done(index_)) return std::nullopt;
-      const int i = index_++;
-      if (!filter_.wanted(i)) continue;
-      const fs::path& p = files_[static_cast<size_t>(i)];
+    for (;;) {
+      while (index_ < static_cast<int>(files_.size())) {
+        if (filter_.done(index_)) return std::nullopt;
+        const int i = index_++;
+        if (!filter_.wanted(i)) continue;
+        const fs::path& p = files_[static_cast<size_t>(i)];
+        Frame f;
+        f.index = i;
+        f.time_s = fps_ > 0 ? i / fps_ : 0.0;
+        f.name = p.string();
+        f.image = to_bgr(read(p));
+        check_size(f.image, expected_, p.string());
+        return f;
+      }
+      if (!following() || !wait_for_more()) return std::nullopt;
+    }
+  }
+  double fps() const override { return fps_; }
+  int frame_count() const override { return following() ? -1 : static_cast<int>(files_.size()); }
+  std::string description() const override {
+    return dir_.string() + (following() ? " (followed: new images are taken as they arrive)"
+                                        : " (" + std::to_string(files_.size()) + " images)");
+  }
+
+ private:
+  bool following() const { return follow_.idle_s > 0; }
+
+  // The folder's images in name order. Following, only names after the last
+  // one taken are added: the order of what was tracked never changes.
+  void scan() {
+    static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
+    std::vector<fs::path> found;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir_, ec)) {
+      if (!e.is_regular_file(ec)) continue;
+      std::string ext = e.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(e.path());
+    }
+    if (ec && files_.empty()) throw InputError(dir_.string() + ": cannot list the folder (" + ec.message() + ")");
+    const auto before = [](const fs::path& a, const fs::path& b) {
+      return natural_less(a.filename().string(), b.filename().string());
+    };
+    // Numbers in names compare by value: frame9.png before frame10.png.
+    std::sort(found.begin(), found.end(), before);
+    for (const auto& f : found) {
+      if (files_.empty() || before(files_.back(), f)) files_.push_back(f);
+    }
+  }
+
+  // Following: polls the folder until a new image appears (true), or none
+  // has for idle_s seconds or the run is cancelled (false).
+  bool wait_for_more() {
+    const auto start = std::chrono::steady_clock::now();
+    const size_t known = files_.size();
+    for (;;) {
+      scan();
+      if (files_.size() > known) return true;
+      if (follow_.cancel && follow_.cancel->load()) return false;
+      const double idle = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (idle >= follow_.idle_s) {
+        logger().info("{}: no new image for {:g} s; the run ends", dir_.string(), follow_.idle_s);
+        return false;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  // An image that does not decode is an error; following, it may still be
+  // being written, so it is read again for up to two seconds first (also
+  // when the decoder complains about a truncated file it could half read).
+  cv::Mat read(const fs::path& p) const {
+    const auto start = std::chrono::steady_clock::now();
+    for (;;) {
       detail::CapturedStderr library;
       cv::Mat img = cv::imread(p.string(), cv::IMREAD_COLOR);
       const std::string said = library.take();
-      if (img.empty()) {
-        throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format" +
-                         (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
+      const bool complete = !img.empty() && (said.empty() || !following());
+      const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (complete || !following() || waited > 2.0) {
+        if (img.empty()) {
+          throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format" +
+                           (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
+        }
+        if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
+        return img;
       }
-      if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
-      Frame f;
-      f.index = i;
-      f.time_s = fps_ > 0 ? i / fps_ : 0.0;
-      f.name = p.string();
-      f.image = to_bgr(img);
-      check_size(f.image, expected_, p.string());
-      return f;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    return std::nullopt;
   }
-  double fps() const override { return fps_; }
-  int frame_count() const override { return static_cast<int>(files_.size()); }
-  std::string description() const override { return dir_.string() + " (" + std::to_string(files_.size()) + " images)"; }
 
- private:
   fs::path dir_;
   std::vector<fs::path> files_;
   ImageSize expected_;
   RangeFilter filter_;
   double fps_;
+  FollowOptions follow_;
   int index_ = 0;
 };
 
@@ -218,6 +275,18 @@ FrameRange parse_frame_range(const std::string& text) {
 
 std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSize expected, FrameRange range,
                                                double fallback_fps) {
+  return open_frame_source(spec, expected, range, fallback_fps, FollowOptions{});
+}
+
+std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSize expected, FrameRange range,
+                                               double fallback_fps, const FollowOptions& follow) {
+  if (follow.idle_s > 0) {
+    std::error_code ec;
+    if (!fs::is_directory(spec, ec)) {
+      throw InputError(spec + ": only a folder of images can be followed (a camera is live already; a video file is "
+                              "read to its end)");
+    }
+  }
   if (range.every < 1) throw InputError("--every must be at least 1");
   if (spec.rfind("camera:", 0) == 0) {
     int dev = -1;
@@ -238,7 +307,7 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   const fs::path p(spec);
   std::error_code ec;
   if (!fs::exists(p, ec)) throw InputError(spec + ": no such file or folder");
-  if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps);
+  if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
   cv::VideoCapture cap;
   // FFmpeg alone when it is there: the other backends print pages of
   // warnings for an undecodable file, and the error below says it in a line.

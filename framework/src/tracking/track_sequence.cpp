@@ -154,7 +154,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     logger().info("{}: no tracker state to resume from; starting from the first frame", state_file.string());
   }
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
-                                  config.tracker.fps > 0 ? config.tracker.fps : 30.0);
+                                  config.tracker.fps > 0 ? config.tracker.fps : 30.0,
+                                  FollowOptions{options.follow_input_s, options.cancel});
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
   if (!resumed && expected_frames(*source, range) == 0) {
     throw InputError(options.input + ": holds " + std::to_string(source->frame_count()) +
