@@ -381,6 +381,14 @@ TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
   for (int i = 1; i < 6; ++i) p = paper.process(half_covered(paper, setup, truth, i + 1), i, i / 30.0, 26.0);
   EXPECT_DOUBLE_EQ(p.outside_allowance, 0.0);
   EXPECT_GT(p.terms.dice, 0.1);
+  // [cost] occlusion_tolerance: the share O may fall short of the model
+  // before any of it is taken as hidden; at 0.8 half a gripper is not enough.
+  auto tolerant_config = config;
+  tolerant_config.cost.occlusion_tolerance = 0.8;
+  gtrack::Tracker tolerant(setup, tolerant_config);
+  tolerant.set_estimate(truth);
+  const auto t = tolerant.process(half_covered(tolerant, setup, truth, 2), 1, 1 / 30.0, 26.0);
+  EXPECT_DOUBLE_EQ(t.outside_allowance, 0.0);
 }
 
 // [tracker] redetect_dice: a track that sits on a wrong configuration while
@@ -472,6 +480,7 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(c.cost.occlusion_discount, 0.0);  // paper
   // Additions on by default (docs/tracker.md); each has a value that turns it off.
   EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
+  EXPECT_DOUBLE_EQ(c.cost.occlusion_tolerance, 0.05);
   EXPECT_DOUBLE_EQ(c.tracker.redetect_dice, 0.01);
   EXPECT_TRUE(c.tracker.mirror_check);
   EXPECT_TRUE(c.tracker.coarse_wide_tilts);

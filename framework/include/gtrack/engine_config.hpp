@@ -71,9 +71,12 @@ struct CostWeights {
   double occlusion_discount = 0.0;
   // occlusion_budget b >= 0: when the observation is smaller than the model
   // rendered at the previous estimate, P\O pixels up to b * (|P_prev| - |O|)
-  // (+ 5 % of |P_prev|) are taken as hidden and not counted in D (see
-  // cost.hpp). 0 = paper's D.
+  // (+ occlusion_tolerance * |P_prev|) are taken as hidden and not counted
+  // in D (see cost.hpp). 0 = paper's D.
   double occlusion_budget = 1.0;
+  // The share of |P_prev| by which O may fall short of the model before any
+  // of it is taken as hidden, and the slack added to the allowance then.
+  double occlusion_tolerance = 0.05;
 };
 
 struct SearchConfig {

@@ -328,7 +328,7 @@ struct Tracker::Impl {
     if (config.cost.occlusion_budget > 0 && previous_area > 0) {
       const double expected = static_cast<double>(previous_area);
       allowance = config.cost.occlusion_budget * (expected - static_cast<double>(observation.count));
-      tolerance = 0.05 * expected;
+      tolerance = config.cost.occlusion_tolerance * expected;
       if (allowance < tolerance) allowance = 0;
     }
     cost->set_outside_allowance(allowance, tolerance);
