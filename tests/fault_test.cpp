@@ -290,7 +290,9 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   o.input = live.string();
   o.out_dir = dir / "out";
   o.progress = false;
-  o.follow_input_s = 1.0;
+  // Generous against a loaded machine (the writer pauses 120 ms per image):
+  // the run then waits 3 s after the last one.
+  o.follow_input_s = 3.0;
   std::thread writer([&] {
     for (int i = 0; i < kFrames; ++i) {
       char name[32];
