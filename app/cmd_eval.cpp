@@ -2,6 +2,11 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <vector>
+#include <string>
+#include <cstdlib>
+#include <optional>
+#include <map>
 #include <set>
 
 #include "command.hpp"
@@ -19,6 +24,75 @@ void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) 
   std::cout << "  " << std::left << std::setw(22) << name << std::right << std::fixed << std::setprecision(2)
             << std::setw(9) << s.mean << " +- " << std::setw(7) << s.std << "  median " << std::setw(8) << s.median
             << "  max " << std::setw(8) << s.max << " " << unit << "\n";
+}
+
+// The occlusion allowance per frame, from the estimates.jsonl beside the
+// estimates (empty when there is none).
+std::map<int, double> allowances(const fs::path& estimates_csv) {
+  std::map<int, double> out;
+  std::ifstream in(estimates_csv.parent_path() / "estimates.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    const auto field = [&](const std::string& key) -> std::optional<double> {
+      const auto at = line.find("\"" + key + "\":");
+      if (at == std::string::npos) return std::nullopt;
+      char* end = nullptr;
+      const char* start = line.c_str() + at + key.size() + 3;
+      const double v = std::strtod(start, &end);
+      return end == start ? std::nullopt : std::optional<double>(v);
+    };
+    const auto frame = field("frame"), allowance = field("outside_allowance");
+    if (frame && allowance) out[static_cast<int>(*frame)] = *allowance;
+  }
+  return out;
+}
+
+// --breakdown: the in-view frames with an estimate, grouped by how much of
+// the gripper the truth says was hidden, and the unoccluded ones by whether
+// the tracker still made an occlusion allowance (where the error of a track
+// comes from; docs/RESULTS.md, "Where the error comes from").
+void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& truth, const fs::path& estimates_csv) {
+  std::map<int, const gtrack::PoseRow*> rows;
+  for (const auto& r : truth.rows) rows[r.frame] = &r;
+  const auto extra = [](const gtrack::PoseRow& r, const char* key) {
+    const auto it = r.extra.find(key);
+    return it == r.extra.end() ? std::optional<double>() : std::optional<double>(it->second);
+  };
+  const auto allowance = allowances(estimates_csv);
+  std::map<std::string, gtrack::ErrorSet> groups;
+  const std::vector<std::string> order = {"unoccluded", "< 40 % hidden", ">= 40 % hidden", "partly out of view",
+                                          "unoccluded, no allowance", "unoccluded, an allowance left"};
+  bool have_occlusion = false;
+  for (const auto& f : ev.per_frame) {
+    if (f.out_of_view || !f.has_estimate || f.lost) continue;
+    const auto r = rows.find(f.frame);
+    if (r == rows.end()) continue;
+    const auto occluded = extra(*r->second, "occluded");
+    if (!occluded) continue;
+    have_occlusion = true;
+    std::string g = *occluded < 0.01 ? order[0] : *occluded < 0.4 ? order[1] : order[2];
+    if (f.in_view < 0.99) g = order[3];
+    groups[g].add(f.errors);
+    if (g == order[0]) {
+      const auto a = allowance.find(f.frame);
+      if (a != allowance.end()) groups[a->second > 0 ? order[5] : order[4]].add(f.errors);
+    }
+  }
+  if (!have_occlusion) {
+    std::cout << "  breakdown: the truth has no 'occluded' column (gtrack synth writes one)\n";
+    return;
+  }
+  std::cout << "  breakdown (in-view frames with an estimate; the allowance rows need estimates.jsonl):\n";
+  for (const auto& name : order) {
+    auto it = groups.find(name);
+    if (it == groups.end()) continue;
+    gtrack::ErrorSet& e = it->second;
+    e.finish();
+    std::cout << "    " << std::left << std::setw(30) << name << std::right << std::setw(5)
+              << e.position_inplane_um.count << " frames  in-plane " << std::setprecision(1) << std::setw(7)
+              << e.position_inplane_um.mean << " um (median " << e.position_inplane_um.median << ")  orientation "
+              << std::setw(5) << e.orientation_deg.mean << " deg (median " << e.orientation_deg.median
+              << ")  joints " << std::setprecision(2) << e.joint_deg.mean << " deg\n";
+  }
 }
 
 int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
@@ -102,6 +176,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   }
   std::cout << "  recovery: " << ev.recovery.size() << " returns into view, " << ev.frames_lost_after_return
             << " frames lost or off track after them\n";
+  if (vm.count("breakdown")) print_breakdown(ev, truth, estimates_file);
   const std::string json = gtrack::evaluation_json(ev);
   if (vm.count("json")) {
     std::ofstream out(vm["json"].as<std::string>());
@@ -122,6 +197,8 @@ GTRACK_COMMAND(
           "config,c", po::value<std::string>(), "config naming the gripper (default: sequence.toml beside the truth)")(
           "json", po::value<std::string>(), "write the summary as JSON")(
           "per-frame", po::value<std::string>(), "write per-frame errors as CSV")(
+          "breakdown", "also the errors by how much of the gripper was hidden, and of unoccluded frames by "
+                       "whether an occlusion allowance was left over")(
           "out-of-view-below", po::value<double>()->default_value(0.1, "0.1"),
           "share of the gripper inside the image under which a frame counts as out of view")(
           "off-track-um", po::value<double>()->default_value(400.0, "400"),

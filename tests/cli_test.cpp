@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -358,6 +359,40 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_NE(r.output.find("header_only.csv: a header and no rows"), std::string::npos) << r.output;
   r = eval(dir / "no_such.csv", truth);
   EXPECT_NE(r.output.find("no_such.csv: no such file"), std::string::npos) << r.output;
+}
+
+// eval --breakdown: every in-view frame with an estimate falls in exactly
+// one occlusion group, and the unoccluded ones again by the allowance.
+TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "breakdown";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 20 --seed 2 --out " + dir.string()).code, 0);
+  ASSERT_EQ(gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() + " -s " +
+                   (dir / "stimulus.csv").string() + " --no-overlay -o " + (dir / "out").string())
+                .code,
+            0);
+  const CliRun r = gtrack("eval -t " + (dir / "ground_truth.csv").string() + " -e " +
+                          (dir / "out" / "estimates.csv").string() + " --breakdown");
+  ASSERT_EQ(r.code, 0) << r.output;
+  int evaluated = -1;  // in view, with a usable estimate (lost frames are not)
+  ASSERT_EQ(std::sscanf(r.output.c_str(), "frames %*d: %*d in view (%d evaluated", &evaluated), 1) << r.output;
+  std::map<std::string, int> groups;
+  std::istringstream lines_in(r.output);
+  for (std::string l; std::getline(lines_in, l);) {
+    const auto at = l.find(" frames  in-plane");
+    if (at == std::string::npos) continue;
+    const auto digits = l.find_last_not_of("0123456789", at - 1);
+    std::string name = l.substr(0, digits + 1);
+    name = name.substr(name.find_first_not_of(' '));
+    name = name.substr(0, name.find_last_not_of(' ') + 1);
+    groups[name] = std::stoi(l.substr(digits + 1, at - digits - 1));
+  }
+  int occlusion = 0;
+  for (const char* g : {"unoccluded", "< 40 % hidden", ">= 40 % hidden", "partly out of view"}) occlusion += groups[g];
+  EXPECT_EQ(occlusion, evaluated) << r.output;
+  EXPECT_EQ(groups["unoccluded, no allowance"] + groups["unoccluded, an allowance left"], groups["unoccluded"])
+      << r.output;
+  EXPECT_GT(groups["unoccluded"], 0) << r.output;
 }
 
 TEST(Cli, UsageErrors) {

@@ -71,7 +71,7 @@ struct FrameEvaluation {
   FrameErrors errors;     // valid when has_estimate && !lost
 };
 
-struct ErrorSet {
+struct GTRACK_API ErrorSet {
   ErrorStats position_um, position_inplane_um, depth_um, orientation_deg, joint_deg, endpoint_um;
   ErrorStats axis_deg[3];
   void add(const FrameErrors& e);
