@@ -175,9 +175,9 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   // Every value is checked before the first sequence is made.
   const auto at_least = [](const std::vector<double>& values, double lo, const char* option) {
     for (double v : values) {
-      if (!(v >= lo) || v != std::floor(v)) {
+      if (!(v >= lo && v <= 100000) || v != std::floor(v)) {
         std::ostringstream m;
-        m << "--" << option << ": expected whole numbers of at least " << lo << ", got " << v;
+        m << "--" << option << ": expected whole numbers from " << lo << " to 100000, got " << v;
         throw gtrack::cli::UsageError(m.str());
       }
     }
@@ -185,9 +185,9 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   at_least(particles, 2, "particles");
   at_least(generations, 1, "generations");
   for (double v : sigmas) {
-    if (!(v >= 0)) {
+    if (!(v >= 0 && v <= 90)) {
       std::ostringstream m;
-      m << "--sigmas: expected values of at least 0, got " << v;
+      m << "--sigmas: expected degrees from 0 to 90, got " << v;
       throw gtrack::cli::UsageError(m.str());
     }
   }

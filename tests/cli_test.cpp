@@ -355,6 +355,14 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_NE(r.output.find("huge_frame.csv:2: expected a frame index (a whole number from 0), got '1e300'"),
             std::string::npos)
       << r.output;
+  // --restart-from refuses a start that is not finite, naming the table.
+  const fs::path nan_table = table("nan_start.csv", {rows[0], replaced(rows[1], ",1.600000,", ",nan,")});
+  const CliRun nan_run = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                                " --no-overlay --frames 1:2 -o " + (dir / "out").string() + " --restart-from " +
+                                nan_table.string());
+  EXPECT_EQ(nan_run.code, 1);
+  EXPECT_NE(nan_run.output.find("nan_start.csv: frame 0: a configuration that is not finite"), std::string::npos)
+      << nan_run.output;
   r = eval(truth, table("header_only.csv", {rows[0]}));
   EXPECT_NE(r.output.find("header_only.csv: a header and no rows"), std::string::npos) << r.output;
   r = eval(dir / "no_such.csv", truth);

@@ -6,6 +6,8 @@
 // finished before the fault present and well-formed in estimates.csv.
 // Runs are tiny (128x128 frames, N=8, G=2) so the whole file takes seconds.
 #include <gtest/gtest.h>
+#include <gtrack/results.hpp>
+#include <algorithm>
 #include <iterator>
 #include <chrono>
 #include <numeric>
@@ -283,7 +285,10 @@ TEST(Fault, FollowedStimulusLogGivesEachFrameTheLatestReading) {
 // idle time.
 TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   const fs::path dir = fresh_dir("follow_input");
-  const fs::path staged = write_frames(dir / "staged", kFrames), live = dir / "live";
+  // Eleven images: img9 must come before img10, which plain name order would
+  // put second.
+  constexpr int kFollowed = 11;
+  const fs::path staged = write_frames(dir / "staged", kFollowed), live = dir / "live";
   fs::create_directories(live);
   const TrackRun r = make_run();
   gtrack::TrackOptions o;
@@ -293,8 +298,10 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   // Generous against a loaded machine (the writer pauses 120 ms per image):
   // the run then waits 3 s after the last one.
   o.follow_input_s = 3.0;
-  std::thread writer([&] {
-    for (int i = 0; i < kFrames; ++i) {
+  // A jthread: joined even when track_sequence throws, so a failure fails
+  // this test instead of ending the whole test program.
+  std::jthread writer([&] {
+    for (int i = 0; i < kFollowed; ++i) {
       char name[32];
       std::snprintf(name, sizeof name, "%06d.png", i);
       std::ifstream in(staged / name, std::ios::binary);
@@ -308,10 +315,30 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   });
   const auto s = gtrack::track_sequence(r.setup, r.config, o);
   writer.join();
-  EXPECT_EQ(s.frames, kFrames);
-  std::vector<int> want(kFrames);
+  EXPECT_EQ(s.frames, kFollowed);
+  std::vector<int> want(kFollowed);
   std::iota(want.begin(), want.end(), 0);
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), want);
+}
+
+// A fresh run into an earlier run's folder: the files of that run the new
+// one might not rewrite go first, so a new run that fails part way never
+// leaves the old summary or overlay beside its own rows. Other files stay.
+TEST(Fault, AFreshRunClearsWhatAnEarlierRunLeft) {
+  const fs::path dir = fresh_dir("earlier_run");
+  for (const char* f : {"overlay.mp4", "overlay_from_000010.avi", "summary.json", "tracker_state.txt", "notes.txt"}) {
+    std::ofstream(dir / f) << "x";
+  }
+  fs::create_directories(dir / "masks");
+  std::ofstream(dir / "masks" / "000003.png") << "x";
+  std::ofstream(dir / "masks" / "readme.txt") << "x";
+  EXPECT_EQ(gtrack::clear_previous_run(dir), 5);
+  std::vector<std::string> left;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) left.push_back(fs::relative(e.path(), dir).string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"masks/readme.txt", "notes.txt"}));
 }
 
 TEST(Fault, OnlyAFolderCanBeFollowed) {

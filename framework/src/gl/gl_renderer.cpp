@@ -299,6 +299,8 @@ void GlRenderer::require_ready(const char* what, Eigen::Index rows) const {
 void GlRenderer::reserve_hypotheses(int count) {
   if (count <= hypothesis_capacity_) return;
   const int capacity = std::max(count, 2 * hypothesis_capacity_);
+  // Nothing is reused if the reallocation below fails part way.
+  hypothesis_capacity_ = 0;
   if (readback_ != nullptr) gl_.UnmapNamedBuffer(readback_buffer_);
   readback_ = nullptr;
   for (GLuint* b : {&hypothesis_buffer_, &count_buffer_, &readback_buffer_}) delete_buffer(gl_, *b);
@@ -329,6 +331,7 @@ void GlRenderer::reserve_layers(int layers) {
                 " layers, the driver allows " + std::to_string(max_layers));
   }
   layers = std::min(std::max(layers, 2 * layer_capacity_), static_cast<int>(max_layers));
+  layer_capacity_ = 0;  // nothing is reused if the reallocation below fails part way
   if (target_ != 0) gl_.DeleteTextures(1, &target_);
   gl_.CreateTextures(GL_TEXTURE_2D_ARRAY, 1, &target_);
   gl_.TextureStorage3D(target_, 1, GL_R32UI, projection_.size.width, projection_.size.height, layers);
@@ -451,7 +454,7 @@ cv::Mat GlRenderer::render_mask(const Eigen::VectorXd& hypothesis) {
   upload_hypotheses(hypothesis.data(), 1);
   draw(1);
   // Layer 0 holds this one hypothesis alone, in bit 0: read as bytes, the
-  // texels are 0 or 1 (a quarter of the 32-bit texels' bytes).
+  // texels are 0 or 1, and a quarter as many bytes cross the bus.
   const int w = projection_.size.width, h = projection_.size.height;
   cv::Mat mask(h, w, CV_8UC1);
   gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);

@@ -7,13 +7,15 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <mutex>
 #include <string>
 
 namespace gtrack::detail {
 
 class CapturedStderr {
  public:
-  CapturedStderr() {
+  // One capture at a time in the process: fd 2 is the process's.
+  CapturedStderr() : lock_(mutex()) {
     std::fflush(stderr);
     file_ = std::tmpfile();
     saved_ = file_ ? ::dup(STDERR_FILENO) : -1;
@@ -56,6 +58,11 @@ class CapturedStderr {
       saved_ = -1;
     }
   }
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
   std::FILE* file_ = nullptr;
   int saved_ = -1;
 };

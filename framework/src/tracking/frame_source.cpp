@@ -180,14 +180,21 @@ class FolderSource final : public FrameSource {
   void scan() {
     static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
     std::vector<fs::path> found;
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(dir_, ec)) {
-      if (!e.is_regular_file(ec)) continue;
-      std::string ext = e.path().extension().string();
+    std::error_code ec;  // of the listing itself
+    for (fs::directory_iterator it(dir_, ec), end; !ec && it != end; it.increment(ec)) {
+      std::error_code entry_ec;  // an entry that vanished or dangles is skipped
+      if (!it->is_regular_file(entry_ec)) continue;
+      std::string ext = it->path().extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(e.path());
+      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(it->path());
     }
-    if (ec && files_.empty()) throw InputError(dir_.string() + ": cannot list the folder (" + ec.message() + ")");
+    if (ec) {
+      // Following, a listing that fails once is tried again at the next poll.
+      if (!following() || files_.empty()) {
+        throw InputError(dir_.string() + ": cannot list the folder (" + ec.message() + ")");
+      }
+      return;
+    }
     const auto before = [](const fs::path& a, const fs::path& b) {
       return natural_less(a.filename().string(), b.filename().string());
     };
@@ -216,27 +223,44 @@ class FolderSource final : public FrameSource {
     }
   }
 
-  // An image that does not decode is an error; following, it may still be
-  // being written, so it is read again for up to two seconds first (also
-  // when the decoder complains about a truncated file it could half read).
+  // An image that does not decode is an error. Following, it may still be
+  // being written: while its size keeps changing, or for two seconds after
+  // it last changed, it is read again (also when it decodes but the decoder
+  // complains, as it does about a half-written JPEG). An image returned
+  // with the decoder's complaint gets a warning naming it.
   cv::Mat read(const fs::path& p) const {
-    const auto start = std::chrono::steady_clock::now();
+    auto changed = std::chrono::steady_clock::now();
+    std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
     for (;;) {
       detail::CapturedStderr library;
       cv::Mat img = cv::imread(p.string(), cv::IMREAD_COLOR);
       const std::string said = library.take();
-      const bool complete = !img.empty() && (said.empty() || !following());
-      const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (complete || !following() || waited > 2.0) {
-        if (img.empty()) {
-          throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format" +
-                           (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
-        }
+      if (!following()) {
+        if (img.empty()) fail_to_read(p, said);
         if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
         return img;
       }
+      std::error_code ec;
+      const std::uintmax_t size = fs::file_size(p, ec);
+      const auto now = std::chrono::steady_clock::now();
+      const bool growing = !ec && size != last_size;
+      if (growing) {
+        changed = now;
+        last_size = size;
+      }
+      const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0;
+      if (!img.empty() && (said.empty() || (!growing && last_size != static_cast<std::uintmax_t>(-1)))) {
+        if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
+        return img;
+      }
+      if (settled) fail_to_read(p, said);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
+  }
+
+  [[noreturn]] static void fail_to_read(const fs::path& p, const std::string& said) {
+    throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format" +
+                     (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
   }
 
   fs::path dir_;

@@ -178,7 +178,7 @@ int clear_previous_run(const fs::path& out_dir) {
     const std::string n = p.filename().string();
     const bool overlay = (n.rfind("overlay.", 0) == 0 || n.rfind("overlay_from_", 0) == 0) &&
                          (p.extension() == ".mp4" || p.extension() == ".avi");
-    if (overlay || n == "tracker_state.txt") stale.push_back(p);
+    if (overlay || n == "tracker_state.txt" || n == "summary.json") stale.push_back(p);
   }
   remove_all_of(stale);
   return static_cast<int>(stale.size()) + remove_frame_images(out_dir / "masks");

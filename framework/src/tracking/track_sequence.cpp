@@ -133,7 +133,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       throw InputError(options.restart_from->string() + ": has " + std::to_string(table.fingers) +
                        " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
     }
-    for (const auto& row : table.rows) restart_rows[row.frame] = row.h;
+    for (const auto& row : table.rows) {
+      if (!row.h.allFinite()) {
+        throw InputError(options.restart_from->string() + ": frame " + std::to_string(row.frame) +
+                         ": a configuration that is not finite cannot be a start (nan or inf in the row)");
+      }
+      restart_rows[row.frame] = row.h;
+    }
   }
   if (options.stimulus_csv) {
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
