@@ -52,7 +52,8 @@ class GTRACK_API FrameSource {
 // the images there are tracked, the source waits for new ones (in name
 // order, after the last one taken) and ends when none has come for idle_s
 // seconds, or when *cancel is raised. An image that does not decode yet (it
-// is still being written) is read again for up to two seconds.
+// is still being written) is read again while its size changes and for two
+// seconds after it last changed.
 struct FollowOptions {
   double idle_s = 0;                          // 0: do not follow
   const std::atomic<bool>* cancel = nullptr;  // raised: stop waiting
