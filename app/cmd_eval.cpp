@@ -1,13 +1,13 @@
 // gtrack eval: estimates against ground truth (paper Section 5.1 metrics).
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <vector>
-#include <string>
-#include <cstdlib>
-#include <optional>
 #include <map>
+#include <optional>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "command.hpp"
 #include "gtrack/error.hpp"
@@ -103,12 +103,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   }
   // Where the results go is checked before anything is computed.
   for (const char* key : {"json", "per-frame"}) {
-    if (!vm.count(key)) continue;
-    const fs::path out(vm[key].as<std::string>());
-    const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-    if (!fs::is_directory(dir)) {
-      throw gtrack::InputError(out.string() + ": the folder '" + dir.string() + "' does not exist (--" + key + ")");
-    }
+    if (vm.count(key)) gtrack::cli::check_output_folder(vm[key].as<std::string>(), key);
   }
   // The model comes from a config: the one given, or the sequence.toml that
   // 'gtrack synth' wrote next to its ground truth.
@@ -158,7 +153,8 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   const auto ev = gtrack::evaluate(setup.model(), truth, estimates, opt, setup.sensor.get());
 
   std::cout << "frames " << ev.frames << ": " << ev.in_view_frames << " in view (" << ev.evaluated_frames
-            << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames << " off track: endpoints > " << opt.off_track_endpoint_um << " um in 3D), "
+            << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames
+            << " off track: endpoints > " << opt.off_track_endpoint_um << " um in 3D), "
             << ev.out_of_view_frames << " out of view; lost in all " << ev.lost_frames << " (missing "
             << ev.missing_frames << ")\n";
   if (ev.evaluated_frames == 0) {

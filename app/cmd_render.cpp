@@ -1,5 +1,4 @@
 // gtrack render: the model as the sensor sees it, as a mask and a posed mesh.
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
@@ -26,14 +25,10 @@ void write_obj(const std::string& path, const std::vector<Eigen::Vector3d>& tris
 // Checked before anything is computed or written: the folder exists, and an
 // image's extension is one OpenCV can write.
 void check_writable(const std::string& path, bool image) {
-  const std::filesystem::path p(path);
-  const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) {
-    throw gtrack::InputError(path + ": the folder '" + dir.string() + "' does not exist");
-  }
+  gtrack::cli::check_output_folder(path);
   if (image && !cv::haveImageWriter(path)) {
-    throw gtrack::InputError(path + ": cannot write images of this kind; expected .png, .jpg, .bmp, .tif, .pgm or .ppm");
+    throw gtrack::InputError(path +
+                             ": cannot write images of this kind; expected .png, .jpg, .bmp, .tif, .pgm or .ppm");
   }
 }
 

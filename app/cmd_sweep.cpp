@@ -173,24 +173,19 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const std::string which = vm["figure"].as<std::string>();
   if (which != "6a" && which != "6b" && which != "both") throw gtrack::cli::UsageError("--figure: 6a, 6b or both");
   // Every value is checked before the first sequence is made.
-  const auto at_least = [](const std::vector<double>& values, double lo, const char* option) {
+  const auto check = [](const std::vector<double>& values, double lo, double hi, bool whole, const char* option,
+                        const char* what) {
     for (double v : values) {
-      if (!(v >= lo && v <= 100000) || v != std::floor(v)) {
+      if (!(v >= lo && v <= hi) || (whole && v != std::floor(v))) {
         std::ostringstream m;
-        m << "--" << option << ": expected whole numbers from " << lo << " to 100000, got " << v;
+        m << "--" << option << ": expected " << what << " from " << lo << " to " << hi << ", got " << v;
         throw gtrack::cli::UsageError(m.str());
       }
     }
   };
-  at_least(particles, 2, "particles");
-  at_least(generations, 1, "generations");
-  for (double v : sigmas) {
-    if (!(v >= 0 && v <= 90)) {
-      std::ostringstream m;
-      m << "--sigmas: expected degrees from 0 to 90, got " << v;
-      throw gtrack::cli::UsageError(m.str());
-    }
-  }
+  check(particles, 2, 100000, true, "particles", "whole numbers");
+  check(generations, 1, 100000, true, "generations", "whole numbers");
+  check(sigmas, 0, 90, false, "sigmas", "degrees");
   if (vm["fig6b-particles"].as<int>() < 2) throw gtrack::cli::UsageError("--fig6b-particles must be at least 2");
   if (vm["fig6b-generations"].as<int>() < 1) throw gtrack::cli::UsageError("--fig6b-generations must be at least 1");
   fs::create_directories(c.out);

@@ -109,7 +109,8 @@ GTRACK_COMMAND(
           "out,o", po::value<std::string>()->required(), "output folder")(
           "backend", po::value<std::string>(), "auto, gl or cpu (default: [render] backend)")(
           "every", po::value<int>()->default_value(1), "track every K-th frame")(
-          "frames", po::value<std::string>(), "A:B, frames A (inclusive) to B (exclusive); A: and :B open-ended; A alone: that frame")(
+          "frames", po::value<std::string>(),
+          "A:B, frames A (inclusive) to B (exclusive); A: and :B open-ended; A alone: that frame")(
           "save-masks", "write each observation O to OUT/masks/NNNNNN.png")(
           "no-overlay", "do not write the overlay video")(
           "resume", "continue the run whose files are in OUT after its last finished frame")(

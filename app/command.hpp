@@ -9,11 +9,14 @@
 #include <boost/program_options.hpp>
 #include <charconv>
 #include <cstdint>
-#include <stdexcept>
 #include <filesystem>
 #include <functional>
+#include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
+
+#include "gtrack/error.hpp"
 
 namespace gtrack::cli {
 
@@ -44,6 +47,17 @@ struct Registrar {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// An output file's folder must exist before anything is computed: the
+// error names the file, the folder, and (when given) the option.
+inline void check_output_folder(const std::filesystem::path& file, const std::string& option = "") {
+  const std::filesystem::path dir = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    throw gtrack::InputError(file.string() + ": the folder '" + dir.string() + "' does not exist" +
+                             (option.empty() ? std::string() : " (--" + option + ")"));
+  }
+}
 
 // --seed: a whole number from 0 to 2^64 - 1. Read as text, because the
 // option parser turns "-1" into 2^64 - 1 for an unsigned option.

@@ -65,7 +65,7 @@ std::string printable(const std::string& text) {
 // The common options may also come before the command
 // (`gtrack --log-level debug plugins`): they are moved after it.
 std::vector<char*> command_first(int argc, char** argv) {
-  std::vector<char*> leading, rest;
+  std::vector<char*> leading;
   int i = 1;
   for (; i < argc; ++i) {
     const std::string a = argv[i];

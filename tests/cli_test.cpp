@@ -39,6 +39,11 @@ fs::path write(const std::string& name, const std::string& text) {
   return p;
 }
 
+// "track -c SEQ/sequence.toml -i SEQ/frames" for a folder 'gtrack synth' wrote.
+std::string track_of(const fs::path& seq) {
+  return "track -c " + (seq / "sequence.toml").string() + " -i " + (seq / "frames").string();
+}
+
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 const std::string kConfig =
@@ -110,9 +115,7 @@ TEST(Cli, StreamPrintsEachEstimateOnStdout) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "stream";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 3 --seed 2 --out " + dir.string()).code, 0);
-  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                              " -o " + (dir / "out").string() + " --no-overlay --stream",
-                          "2>/dev/null");
+  const CliRun r = gtrack(track_of(dir) + " -o " + (dir / "out").string() + " --no-overlay --stream", "2>/dev/null");
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(dir / "out" / "estimates.jsonl");
   std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -129,8 +132,7 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 30 --seed 4 --out " + dir.string()).code, 0);
   const fs::path err = dir / "stderr.txt";
-  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                              " -o " + (dir / "out").string() + " --no-overlay --stream",
+  const CliRun r = gtrack(track_of(dir) + " -o " + (dir / "out").string() + " --no-overlay --stream",
                           "2>" + err.string() + " | head -n 1");
   EXPECT_EQ(lines(r.output), 1) << r.output;
   std::ifstream in(err);
@@ -163,8 +165,8 @@ TEST(Cli, RestartFromTheTruthTracksEachFrameFromThePreviousTruth) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "restart";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 9 --seed 3 --out " + dir.string()).code, 0);
-  const std::string track = "track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                            " -s " + (dir / "stimulus.csv").string() + " --frames 5:9 --no-overlay -o ";
+  const std::string track =
+      track_of(dir) + " -s " + (dir / "stimulus.csv").string() + " --frames 5:9 --no-overlay -o ";
   CliRun r = gtrack(track + (dir / "plain").string());
   ASSERT_EQ(r.code, 0) << r.output;
   r = gtrack(track + (dir / "restarted").string() + " --restart-from " + (dir / "ground_truth.csv").string());
@@ -192,8 +194,8 @@ TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {
   ASSERT_EQ(gtrack("synth --frames 2 --seed 3 --out " + dir.string()).code, 0);
   const fs::path table = write("two_fingers.csv",
                                "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg\n0,0,0,100,0,0,0,0,0\n");
-  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                          " --no-overlay -o " + (dir / "out").string() + " --restart-from " + table.string());
+  const CliRun r =
+      gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out").string() + " --restart-from " + table.string());
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find(table.string() + ": has 2 joint columns, the gripper of this config has 6"),
@@ -225,8 +227,7 @@ TEST(Cli, TrackIntoAnEarlierRunReplacesIt) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "track_again";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 3 --seed 5 --out " + dir.string()).code, 0);
-  const std::string track =
-      "track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() + " -o " + (dir / "out").string();
+  const std::string track = track_of(dir) + " -o " + (dir / "out").string();
   CliRun r = gtrack(track + " --save-masks");
   ASSERT_EQ(r.code, 0) << r.output;
   ASSERT_EQ(count_files(dir / "out" / "masks", ".png"), 3);
@@ -252,7 +253,8 @@ std::string hydrogel_config() {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-const std::string kParams = " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + (fs::temp_directory_path() / "gtrack_cli_test" / "m.png").string();
+const std::string kParams =
+    " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + (fs::temp_directory_path() / "gtrack_cli_test" / "m.png").string();
 
 // A key or table that is missing points at the unread one it was likely
 // meant to be, with its line.
@@ -264,7 +266,8 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   EXPECT_EQ(lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("key 'sensor.fx': missing; expected a number > 0 (is 'fxx' on line "), std::string::npos)
       << r.output;
-  const fs::path plugin = write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
+  const fs::path plugin =
+      write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
   r = gtrack("render -c " + plugin.string() + kParams);
   EXPECT_NE(r.output.find("key 'gripper.plugin': missing"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(is 'plugn' on line "), std::string::npos) << r.output;
@@ -306,8 +309,7 @@ TEST(Cli, ADamagedImageIsOneLineWithTheDecodersWords) {
     bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   }
   std::ofstream(frame, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 3);
-  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                          " --no-overlay --log-level warn -o " + (dir / "out").string());
+  const CliRun r = gtrack(track_of(dir) + " --no-overlay --log-level warn -o " + (dir / "out").string());
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find(frame.string() + ": cannot read the image"), std::string::npos) << r.output;
@@ -317,8 +319,7 @@ TEST(Cli, AFrameRangeOutsideTheInputIsAnError) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "range";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 3 --seed 6 --out " + dir.string()).code, 0);
-  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                          " --no-overlay --frames 20:30 -o " + (dir / "out").string());
+  const CliRun r = gtrack(track_of(dir) + " --no-overlay --frames 20:30 -o " + (dir / "out").string());
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("holds 3 frames, none of them in --frames 20:30"), std::string::npos) << r.output;
 }
@@ -357,9 +358,8 @@ TEST(Cli, EvalRefusesMalformedTables) {
       << r.output;
   // --restart-from refuses a start that is not finite, naming the table.
   const fs::path nan_table = table("nan_start.csv", {rows[0], replaced(rows[1], ",1.600000,", ",nan,")});
-  const CliRun nan_run = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
-                                " --no-overlay --frames 1:2 -o " + (dir / "out").string() + " --restart-from " +
-                                nan_table.string());
+  const CliRun nan_run = gtrack(track_of(dir) + " --no-overlay --frames 1:2 -o " + (dir / "out").string() +
+                                " --restart-from " + nan_table.string());
   EXPECT_EQ(nan_run.code, 1);
   EXPECT_NE(nan_run.output.find("nan_start.csv: frame 0: a configuration that is not finite"), std::string::npos)
       << nan_run.output;
@@ -375,10 +375,10 @@ TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "breakdown";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 20 --seed 2 --out " + dir.string()).code, 0);
-  ASSERT_EQ(gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() + " -s " +
-                   (dir / "stimulus.csv").string() + " --no-overlay -o " + (dir / "out").string())
-                .code,
-            0);
+  ASSERT_EQ(
+      gtrack(track_of(dir) + " -s " + (dir / "stimulus.csv").string() + " --no-overlay -o " + (dir / "out").string())
+          .code,
+      0);
   const CliRun r = gtrack("eval -t " + (dir / "ground_truth.csv").string() + " -e " +
                           (dir / "out" / "estimates.csv").string() + " --breakdown");
   ASSERT_EQ(r.code, 0) << r.output;

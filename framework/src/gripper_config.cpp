@@ -20,8 +20,8 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
                                  " ends are needed (the built-in ones are for " +
                                  std::to_string(d.widths_mm.size() - 1) + " links)");
   }
-  std::vector<double> widths = t.numbers_or("link_widths_mm", lengths_changed ? std::vector<double>{} : d.widths_mm,
-                                            lengths.size() + 1, Range::non_negative());
+  std::vector<double> widths =
+      t.numbers_or("link_widths_mm", d.widths_mm, lengths.size() + 1, Range::non_negative());
   spec.links.clear();
   for (size_t j = 0; j < lengths.size(); ++j) spec.links.push_back({lengths[j], widths[j], widths[j + 1]});
 

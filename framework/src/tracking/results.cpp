@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "gtrack/error.hpp"
+#include "gtrack/sequence_io.hpp"
 #include "replace_file.hpp"
 
 namespace gtrack {
@@ -29,11 +30,8 @@ std::ofstream open_for_writing(const fs::path& p, bool append) {
   return out;
 }
 
-std::string csv_header(int fingers) {
-  std::string h = "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg";
-  for (int f = 1; f <= fingers; ++f) h += ",q" + std::to_string(f) + "_deg";
-  return h + ",cost,status,ms";
-}
+// The header of estimates.csv: a pose table with the tracker's columns.
+std::string csv_header(int fingers) { return pose_table_header(fingers, {"cost", "status", "ms"}); }
 
 // Whole lines only: a last line without its newline was cut short.
 std::vector<std::string> complete_lines(const fs::path& p) {

@@ -87,10 +87,9 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   if (!(g.joint_min_deg < g.joint_max_deg)) t.fail("joint_max_deg", "must be greater than joint_min_deg");
   g.collision.max_difference_deg = t.number_or("max_adjacent_difference_deg", 45, Range::positive());
   g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", 1e9, Range::positive());
-  // A radial gripper is symmetric under a turn by one finger; one drawn
-  // finger by finger is not, unless said so.
-  const int symmetry = t.has("radial") ? static_cast<int>(g.fingers.size()) : 1;
-  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", symmetry, Range{1, 64}));
+  // Default: what the geometry has already; a radial gripper is symmetric
+  // under a turn by one finger, one drawn finger by finger is not.
+  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", g.symmetry_order, Range{1, 64}));
   g.unfolded_deg = t.number_or("unfolded_deg", 0);
   g.folded_deg = t.number_or("folded_deg", 60);
   return g;
