@@ -46,6 +46,13 @@ std::string track_of(const fs::path& seq) {
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
+// A refused command: exit status 1 and one line that says `what`.
+void expect_refusal(const CliRun& r, const std::string& what) {
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(what), std::string::npos) << r.output;
+}
+
 const std::string kConfig =
     "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\nfx = 3200\n"
     "[gripper]\nplugin = \"hydrogel_six_finger\"\n";
@@ -62,9 +69,7 @@ TEST(Cli, PluginsListsTheBuiltInsEachFromItsOwnLibrary) {
 TEST(Cli, MisspelledKeyIsOneLineWithFileLineKey) {
   fs::path cfg = write("typo.toml", kConfig + "link_lenghts_mm = [0.3, 0.3]\n");
   CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out /tmp/x.png");
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find(cfg.string() + ":8: key 'gripper.link_lenghts_mm'"), std::string::npos) << r.output;
+  expect_refusal(r, cfg.string() + ":8: key 'gripper.link_lenghts_mm'");
   EXPECT_NE(r.output.find("did you mean 'link_lengths_mm'"), std::string::npos) << r.output;
 }
 
@@ -72,9 +77,7 @@ TEST(Cli, UnknownPluginListsThoseThatExist) {
   fs::path cfg = write("unknown.toml", "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 64\nheight = 64\nfx = 100\n"
                                        "[gripper]\nplugin = \"hydrogel_seven_finger\"\n");
   CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out /tmp/x.png");
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find("gripper plugin 'hydrogel_seven_finger' not found"), std::string::npos) << r.output;
+  expect_refusal(r, "gripper plugin 'hydrogel_seven_finger' not found");
   EXPECT_NE(r.output.find("available gripper plugins: "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("hydrogel_six_finger"), std::string::npos) << r.output;
 }
@@ -101,9 +104,7 @@ TEST(Cli, RenderWritesMaskAndObj) {
 TEST(Cli, BadParameterVectorIsOneLine) {
   fs::path cfg = write("ok2.toml", kConfig);
   CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,abc --out /tmp/x.png");
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find("field 3 ('abc')"), std::string::npos) << r.output;
+  expect_refusal(r, "field 3 ('abc')");
   r = gtrack("render --config " + cfg.string() + " --params 0,0,1 --out /tmp/x.png");
   EXPECT_NE(r.output.find("got 3 values, expected 12"), std::string::npos) << r.output;
 }
@@ -196,11 +197,7 @@ TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {
                                "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg\n0,0,0,100,0,0,0,0,0\n");
   const CliRun r =
       gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out").string() + " --restart-from " + table.string());
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find(table.string() + ": has 2 joint columns, the gripper of this config has 6"),
-            std::string::npos)
-      << r.output;
+  expect_refusal(r, table.string() + ": has 2 joint columns, the gripper of this config has 6");
 }
 
 int count_files(const fs::path& dir, const std::string& extension) {
@@ -262,10 +259,7 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   const std::string base = hydrogel_config();
   const fs::path key = write("fxx.toml", replaced(base, "\nfx = ", "\nfxx = "));
   CliRun r = gtrack("render -c " + key.string() + kParams);
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find("key 'sensor.fx': missing; expected a number > 0 (is 'fxx' on line "), std::string::npos)
-      << r.output;
+  expect_refusal(r, "key 'sensor.fx': missing; expected a number > 0 (is 'fxx' on line ");
   const fs::path plugin =
       write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
   r = gtrack("render -c " + plugin.string() + kParams);
@@ -289,9 +283,7 @@ TEST(Cli, RenderChecksTheConfigAndItsOutputsFirst) {
       << r.output;
   const fs::path ok = write("render_ok.toml", hydrogel_config());
   r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o mask.jpgx");
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find("mask.jpgx: cannot write images of this kind"), std::string::npos) << r.output;
+  expect_refusal(r, "mask.jpgx: cannot write images of this kind");
   r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o no_such_folder/mask.png");
   EXPECT_NE(r.output.find("the folder 'no_such_folder' does not exist"), std::string::npos) << r.output;
 }
@@ -310,9 +302,7 @@ TEST(Cli, ADamagedImageIsOneLineWithTheDecodersWords) {
   }
   std::ofstream(frame, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 3);
   const CliRun r = gtrack(track_of(dir) + " --no-overlay --log-level warn -o " + (dir / "out").string());
-  EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  EXPECT_NE(r.output.find(frame.string() + ": cannot read the image"), std::string::npos) << r.output;
+  expect_refusal(r, frame.string() + ": cannot read the image");
 }
 
 TEST(Cli, AFrameRangeOutsideTheInputIsAnError) {

@@ -147,6 +147,22 @@ std::vector<int> valid_rows(const fs::path& csv) {
 
 bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == std::string::npos; }
 
+// The message of the InputError a run stops with ("" when it runs through).
+std::string track_error(const TrackRun& r, const gtrack::TrackOptions& o) {
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+  } catch (const gtrack::InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+// A refusal is one line that names `what`.
+void expect_refusal_naming(const std::string& message, const std::string& what) {
+  EXPECT_TRUE(one_line(message)) << (message.empty() ? "not refused" : message);
+  EXPECT_NE(message.find(what), std::string::npos) << message;
+}
+
 struct CliRun {
   int code;
   std::string output;
@@ -212,13 +228,7 @@ TEST(Fault, CorruptImageInFolderStopsWithTheFramesBefore) {
   o.input = frames.string();
   o.out_dir = dir / "out";
   o.progress = false;
-  try {
-    gtrack::track_sequence(r.setup, r.config, o);
-    FAIL() << "a corrupt image must stop the run";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_TRUE(one_line(e.what())) << e.what();
-    EXPECT_NE(std::string(e.what()).find("000005.png"), std::string::npos) << e.what();
-  }
+  expect_refusal_naming(track_error(r, o), "000005.png");
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), (std::vector<int>{0, 1, 2, 3, 4}));
 }
 
@@ -347,13 +357,7 @@ TEST(Fault, OnlyAFolderCanBeFollowed) {
   gtrack::TrackOptions o = folder_run(dir, 2);
   o.input = (dir / "frames" / "000000.png").string();
   o.follow_input_s = 1.0;
-  try {
-    gtrack::track_sequence(r.setup, r.config, o);
-    FAIL() << "following a file was accepted";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_TRUE(one_line(e.what())) << e.what();
-    EXPECT_NE(std::string(e.what()).find("only a folder of images can be followed"), std::string::npos) << e.what();
-  }
+  expect_refusal_naming(track_error(r, o), "only a folder of images can be followed");
 }
 
 // A stimulus log cut in the middle of a row (the logger died while writing):
@@ -369,13 +373,7 @@ TEST(Fault, StimulusLogCutMidRowIsRefusedWithFileAndLine) {
   o.stimulus_csv = csv;
   o.out_dir = dir / "out";
   o.progress = false;
-  try {
-    gtrack::track_sequence(r.setup, r.config, o);
-    FAIL() << "a malformed last row must be refused";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_TRUE(one_line(e.what())) << e.what();
-    EXPECT_NE(std::string(e.what()).find("stimulus.csv:4:"), std::string::npos) << e.what();
-  }
+  expect_refusal_naming(track_error(r, o), "stimulus.csv:4:");
   EXPECT_FALSE(fs::exists(o.out_dir / "estimates.csv"));
 }
 
@@ -393,13 +391,7 @@ TEST(Fault, UnwritableOutputFolderIsRefusedUpFront) {
     o.progress = false;
     int frames_run = 0;
     o.on_frame = [&](const gtrack::Estimate&) { ++frames_run; };
-    try {
-      gtrack::track_sequence(r.setup, r.config, o);
-      FAIL() << out << " must be refused";
-    } catch (const gtrack::InputError& e) {
-      EXPECT_TRUE(one_line(e.what())) << e.what();
-      EXPECT_NE(std::string(e.what()).find(out.string()), std::string::npos) << e.what();
-    }
+    expect_refusal_naming(track_error(r, o), out.string());
     EXPECT_EQ(frames_run, 0);
   }
 }
@@ -418,13 +410,7 @@ TEST(Fault, DiskFullMidRunStopsWithOneLine) {
   o.input = write_frames(dir / "frames", kFrames).string();
   o.out_dir = out;
   o.progress = false;
-  try {
-    gtrack::track_sequence(r.setup, r.config, o);
-    FAIL() << "writes to a full disk must stop the run";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_TRUE(one_line(e.what())) << e.what();
-    EXPECT_NE(std::string(e.what()).find("disk full"), std::string::npos) << e.what();
-  }
+  expect_refusal_naming(track_error(r, o), "disk full");
   // The CSV row of the frame whose JSON line failed is already flushed.
   EXPECT_LE(valid_rows(out / "estimates.csv").size(), 1u);
 }
@@ -440,13 +426,7 @@ TEST(Fault, OutputFolderRemovedMidRunStopsAtTheNextFrame) {
   o.on_frame = [&](const gtrack::Estimate&) {
     if (++frames_run == 3) fs::remove_all(o.out_dir);
   };
-  try {
-    gtrack::track_sequence(r.setup, r.config, o);
-    FAIL() << "the tracker state cannot be written into a removed folder";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_TRUE(one_line(e.what())) << e.what();
-    EXPECT_NE(std::string(e.what()).find("tracker_state.txt"), std::string::npos) << e.what();
-  }
+  expect_refusal_naming(track_error(r, o), "tracker_state.txt");
   EXPECT_EQ(frames_run, 3);
 }
 
@@ -571,13 +551,7 @@ TEST(Fault, ResumeRefusesADamagedStateWithFileAndLine) {
     gtrack::TrackOptions again = o;
     again.range.last = -1;
     again.resume = true;
-    try {
-      gtrack::track_sequence(r.setup, r.config, again);
-      ADD_FAILURE() << "must be refused: " << what;
-    } catch (const gtrack::InputError& e) {
-      EXPECT_TRUE(one_line(e.what())) << e.what();
-      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-    }
+    expect_refusal_naming(track_error(r, again), what);
     EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), 3u);
   };
   std::ofstream(state) << text.substr(0, text.find("last ")) << "last 1 2 nan\n";
