@@ -170,6 +170,22 @@ TEST(Cost, OutsideAllowanceTakesTheMissingAreaAsHidden) {
   EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(45, 50, 60, 1.0, 0), gtrack::dice_distance(45, 50, 60));
 }
 
+TEST(Cost, GrowthIntoTheToleranceIsWeighted) {
+  // O = 50 pixels, allowance 50, tolerance 10. A hypothesis 8 pixels larger
+  // than the allowance (58 outside) lies in the tolerance: free at weight 0,
+  // 0.25 * 8 = 2 pixels counted at 0.25.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 108, 1.0, 50, 10, 0.0), 0.0);
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 108, 1.0, 50, 10, 0.25), 1.0 - 100.0 / 102.0);
+  // Beyond the tolerance the excess counts in full, the tolerance at its weight:
+  // 75 outside = 50 allowed + 10 at 0.5 + 15.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 125, 1.0, 50, 10, 0.5), 1.0 - 100.0 / 120.0);
+  // Within the allowance itself nothing is counted, whatever the weight.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50, 10, 1.0), 0.0);
+  // So with a weight, growing from the allowed size costs, and the true size does not.
+  EXPECT_LT(gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50, 10, 0.1),
+            gtrack::weighted_dice_distance(50, 50, 105, 1.0, 50, 10, 0.1));
+}
+
 TEST(Cost, OccludedTruePoseBeatsShrunkenModelWithOutsideAllowance) {
   CountsRenderer r;
   r.observed = 50;

@@ -593,6 +593,7 @@ TEST(Fault, NonFiniteConfigValuesAreRefusedWithFileLineKey) {
       {"observation", "prior_sigma_px", "inf"}, {"search", "position_min_mm", "[-inf, 0.0, 90.0]"},
       {"tracker", "initial_pose", "[0, 0, nan, 0, 0, 0, 0, 0, 0, 0, 0, 0]"},
       {"tracker", "default_stimulus", "nan"}, {"tracker", "fps", "inf"},
+      {"cost", "occlusion_growth_weight", "nan"},
   };
   for (const auto& c : cases) {
     // Replace the key if the base config has it, else add it to its table.

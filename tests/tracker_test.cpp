@@ -481,6 +481,7 @@ TEST(EngineConfig, PaperDefaults) {
   // Additions on by default (docs/tracker.md); each has a value that turns it off.
   EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_tolerance, 0.05);
+  EXPECT_DOUBLE_EQ(c.cost.occlusion_growth_weight, 0.1);
   EXPECT_DOUBLE_EQ(c.tracker.redetect_dice, 0.01);
   EXPECT_TRUE(c.tracker.mirror_check);
   EXPECT_TRUE(c.tracker.coarse_wide_tilts);

@@ -40,14 +40,16 @@ GTRACK_API double dice_distance(std::uint64_t intersection, std::uint64_t observ
 // leaves observed pixels uncovered.
 //
 // allowance a > 0, tolerance t: P\O pixels up to a + t are taken as hidden by
-// an occluder and not counted (only the excess is, weighted by w); a = 0 is
-// no allowance at all (t is ignored). With a set to
+// an occluder and not counted (only the excess is, weighted by w), except
+// that those between a and a + t count with tolerance_weight (times w); a = 0
+// is no allowance at all (t is ignored). With a set to
 // the area the observation lacks compared with the model's expected area,
 // the true configuration of a partly hidden gripper scores about 0, as it
 // would unoccluded, so shrinking or folding the hidden part away no longer
 // pays, while a hypothesis that grows beyond the expected area still does.
 GTRACK_API double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
-                                         double outside_weight, double allowance = 0, double tolerance = 0);
+                                         double outside_weight, double allowance = 0, double tolerance = 0,
+                                         double tolerance_weight = 0);
 
 // The temporal term T: mean over parameters of ((h_d - p_d) / sigma_d)^2, p
 // the prediction; rz (index 5) differences are taken the short way when

@@ -77,6 +77,12 @@ struct CostWeights {
   // The share of |P_prev| by which O may fall short of the model before any
   // of it is taken as hidden, and the slack added to the allowance then.
   double occlusion_tolerance = 0.05;
+  // occlusion_growth_weight in [0, 1]: the weight in D of the P\O pixels in
+  // that slack (beyond b * (|P_prev| - |O|), up to the tolerance). At 0 a
+  // hypothesis may be larger than the previous model by the slack for free;
+  // the next frame's allowance, taken from that larger model, lets it grow
+  // again, so under a long occlusion the model ratchets up.
+  double occlusion_growth_weight = 0.1;
 };
 
 struct SearchConfig {

@@ -17,14 +17,19 @@ double dice_distance(std::uint64_t intersection, std::uint64_t observed, std::ui
 }
 
 double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
-                              double outside_weight, double allowance, double tolerance) {
+                              double outside_weight, double allowance, double tolerance, double tolerance_weight) {
   if (intersection > rendered) intersection = rendered;
   const double w = outside_weight < 0 ? 0.0 : (outside_weight > 1 ? 1.0 : outside_weight);
   const double i = static_cast<double>(intersection);
   // |P\O| beyond the allowance (plus its tolerance): the part of the
-  // hypothesis that cannot be hidden by the occluder.
+  // hypothesis that cannot be hidden by the occluder. The part within the
+  // tolerance counts with its own weight.
   double outside = static_cast<double>(rendered - intersection);
-  if (allowance > 0) outside = std::max(0.0, outside - allowance - std::max(0.0, tolerance));
+  if (allowance > 0) {
+    const double t = std::max(0.0, tolerance);
+    const double slack = std::clamp(outside - allowance, 0.0, t);
+    outside = std::max(0.0, outside - allowance - t) + std::clamp(tolerance_weight, 0.0, 1.0) * slack;
+  }
   const double denom = static_cast<double>(observed) + i + w * outside;  // 2|O&P| + |O\P| + w|P\O|
   if (denom <= 0) return rendered == 0 ? 0.0 : 1.0;
   const double d = 1.0 - 2.0 * i / denom;
@@ -77,7 +82,7 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     const std::uint64_t observed = r->observation_count();
     for (int i = 0; i < n; ++i) {
       out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_,
-                                            outside_allowance_, outside_tolerance_);
+                                            outside_allowance_, outside_tolerance_, weights_.occlusion_growth_weight);
     }
   }
   const double views = static_cast<double>(renderers_.size());

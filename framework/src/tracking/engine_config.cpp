@@ -65,6 +65,8 @@ CostWeights read_cost(const ConfigTable& t) {
   c.occlusion_discount = t.number_or("occlusion_discount", c.occlusion_discount, Range::closed(0.0, 1.0));
   c.occlusion_budget = t.number_or("occlusion_budget", c.occlusion_budget, Range::closed(0.0, 4.0));
   c.occlusion_tolerance = t.number_or("occlusion_tolerance", c.occlusion_tolerance, Range::closed(0.0, 1.0));
+  c.occlusion_growth_weight =
+      t.number_or("occlusion_growth_weight", c.occlusion_growth_weight, Range::closed(0.0, 1.0));
   return c;
 }
 
