@@ -46,6 +46,12 @@ std::string track_of(const fs::path& seq) {
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
+// A whole file, byte for byte ("" when it cannot be read).
+std::string read_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 // A refused command: exit status 1 and one line that says `what`.
 void expect_refusal(const CliRun& r, const std::string& what) {
   EXPECT_EQ(r.code, 1);
@@ -118,8 +124,7 @@ TEST(Cli, StreamPrintsEachEstimateOnStdout) {
   ASSERT_EQ(gtrack("synth --frames 3 --seed 2 --out " + dir.string()).code, 0);
   const CliRun r = gtrack(track_of(dir) + " -o " + (dir / "out").string() + " --no-overlay --stream", "2>/dev/null");
   ASSERT_EQ(r.code, 0) << r.output;
-  std::ifstream in(dir / "out" / "estimates.jsonl");
-  std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string written = read_file(dir / "out" / "estimates.jsonl");
   EXPECT_EQ(lines(r.output), 3) << r.output;
   EXPECT_EQ(r.output, written);
   EXPECT_EQ(r.output.rfind("{\"frame\":0,", 0), 0u) << r.output;
@@ -136,11 +141,9 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   const CliRun r = gtrack(track_of(dir) + " -o " + (dir / "out").string() + " --no-overlay --stream",
                           "2>" + err.string() + " | head -n 1");
   EXPECT_EQ(lines(r.output), 1) << r.output;
-  std::ifstream in(err);
-  const std::string e((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string e = read_file(err);
   EXPECT_NE(e.find("gtrack track: stdout was closed by its reader; stopped after "), std::string::npos) << e;
-  std::ifstream summary(dir / "out" / "summary.json");
-  const std::string s((std::istreambuf_iterator<char>(summary)), std::istreambuf_iterator<char>());
+  const std::string s = read_file(dir / "out" / "summary.json");
   EXPECT_NE(s.find("\"cancelled\": true"), std::string::npos) << s;
 }
 
@@ -246,8 +249,7 @@ std::string replaced(const std::string& text, const std::string& from, const std
 }
 
 std::string hydrogel_config() {
-  std::ifstream in(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml");
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml");
 }
 
 const std::string kParams =
@@ -295,11 +297,7 @@ TEST(Cli, ADamagedImageIsOneLineWithTheDecodersWords) {
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 2 --seed 6 --out " + dir.string()).code, 0);
   const fs::path frame = dir / "frames" / "000001.png";
-  std::string bytes;
-  {
-    std::ifstream in(frame, std::ios::binary);
-    bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  }
+  const std::string bytes = read_file(frame);
   std::ofstream(frame, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 3);
   const CliRun r = gtrack(track_of(dir) + " --no-overlay --log-level warn -o " + (dir / "out").string());
   expect_refusal(r, frame.string() + ": cannot read the image");

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 #include <gtrack/results.hpp>
 #include <algorithm>
-#include <iterator>
 #include <chrono>
 #include <numeric>
 #include <thread>
@@ -42,7 +41,7 @@ constexpr int kSide = 128;
 constexpr int kFrames = 8;
 
 std::string read_text(const fs::path& file) {
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
@@ -314,8 +313,7 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
     for (int i = 0; i < kFollowed; ++i) {
       char name[32];
       std::snprintf(name, sizeof name, "%06d.png", i);
-      std::ifstream in(staged / name, std::ios::binary);
-      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      const std::string bytes = read_text(staged / name);
       const fs::path to = live / ("img" + std::to_string(i) + ".png");
       std::ofstream(to, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
       std::this_thread::sleep_for(std::chrono::milliseconds(60));
