@@ -1,5 +1,6 @@
 // gtrack: one executable, one subcommand per job (see command.hpp).
 #include <boost/program_options.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -62,15 +63,24 @@ std::string printable(const std::string& text) {
   return out;
 }
 
-// The common options may also come before the command
+// The common options that take a value may also come before the command
 // (`gtrack --log-level debug plugins`): they are moved after it.
 std::vector<char*> command_first(int argc, char** argv) {
+  std::vector<std::string> valued;  // "--name" of each common option with a value
+  const po::options_description common = common_options();
+  for (const auto& o : common.options()) {
+    if (o->semantic()->max_tokens() > 0) valued.push_back("--" + o->long_name());
+  }
+  const auto is_valued = [&](const std::string& a) {
+    return std::find(valued.begin(), valued.end(), a) != valued.end();
+  };
   std::vector<char*> leading;
   int i = 1;
   for (; i < argc; ++i) {
     const std::string a = argv[i];
-    const bool with_value = a == "--log-level" || a == "--plugin-path";
-    const bool joined = a.rfind("--log-level=", 0) == 0 || a.rfind("--plugin-path=", 0) == 0;
+    const bool with_value = is_valued(a);
+    const size_t eq = a.find('=');
+    const bool joined = eq != std::string::npos && is_valued(a.substr(0, eq));
     if (with_value && i + 1 < argc) {
       leading.push_back(argv[i]);
       leading.push_back(argv[++i]);

@@ -72,6 +72,17 @@ TEST(Cli, PluginsListsTheBuiltInsEachFromItsOwnLibrary) {
   EXPECT_NE(r.output.find("libgtrack_pinhole_microscope.so"), std::string::npos);
 }
 
+// The common options that take a value may come before the command, spelt
+// either way; the folder given is searched first.
+TEST(Cli, CommonOptionsMayComeBeforeTheCommand) {
+  const std::string dir = fs::temp_directory_path().string();
+  for (const std::string& before : {"--plugin-path " + dir + " --log-level warn", "--plugin-path=" + dir}) {
+    const CliRun r = gtrack(before + " plugins --paths");
+    ASSERT_EQ(r.code, 0) << before << ": " << r.output;
+    EXPECT_EQ(r.output.rfind(dir + "\n", 0), 0u) << before << ": " << r.output;
+  }
+}
+
 TEST(Cli, MisspelledKeyIsOneLineWithFileLineKey) {
   fs::path cfg = write("typo.toml", kConfig + "link_lenghts_mm = [0.3, 0.3]\n");
   CliRun r = gtrack("render --config " + cfg.string() + " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out /tmp/x.png");
