@@ -1,6 +1,12 @@
 // temperature_hysteresis against the paper's rules (Sections 2.2, 3, 5).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
 #include "support/plugins.hpp"
 
 using gtrack::testing::make_stimulus;
@@ -65,6 +71,9 @@ TEST(TemperatureHysteresis, TheMaterialGetsTimeToSettle) {
   EXPECT_DOUBLE_EQ(s->penalty(lagging), 0.0);  // just arrived: still folding
   ramp(*s, 28.0, 28.0, 2, 7);                  // t = 9 s: 3 s above 27 C
   EXPECT_NEAR(s->penalty(lagging), 40.0 / 60.0, 1e-12);
+  auto hot = make_stimulus(kHydrogel);  // a sequence that starts hot starts settled
+  hot->update(30.0, 0.0);
+  EXPECT_NEAR(hot->penalty(lagging), 40.0 / 60.0, 1e-12);
   auto instant = make_stimulus("plugin = \"temperature_hysteresis\"\nsettle_s = 0");
   ramp(*instant, 22.0, 28.0, 6);
   EXPECT_NEAR(instant->penalty(lagging), 40.0 / 60.0, 1e-12);
@@ -93,11 +102,62 @@ TEST(TemperatureHysteresis, MetallicGrippersFoldAtTriggerAndNeverUnfold) {
   EXPECT_DOUBLE_EQ(s->target_joint_deg(70.0), 70.0);
 }
 
+// A material with a first-order response of time constant tau, driven the
+// way the synthetic sequences drive it, against the feasible range of a
+// stimulus that knows the response time within a factor of two.
+double worst_penalty_of_a_lagging_material(const std::string& table, double tau, const std::vector<double>& temps) {
+  auto material = make_stimulus(table);  // the material's own state
+  auto tracked = make_stimulus(table + "\nresponse_s = 0.5");
+  const double dt = 1.0 / 30;
+  double q = 0, worst = 0;
+  for (std::size_t i = 0; i < temps.size(); ++i) {
+    material->update(temps[i], i * dt);
+    tracked->update(temps[i], i * dt);
+    if (i > 0) q += (material->target_joint_deg(q) - q) * (1 - std::exp(-dt / tau));
+    worst = std::max(worst, tracked->penalty(std::vector<double>(6, q)));
+  }
+  return worst;
+}
+
+std::vector<double> heat_and_cool(double low, double high, int frames) {
+  std::vector<double> t;
+  for (int i = 0; i < frames; ++i) t.push_back(0.5 * (low + high) - 0.5 * (high - low) * std::cos(2 * std::numbers::pi * i / 150.0));
+  return t;
+}
+
+TEST(TemperatureHysteresis, TheResponseTimeKeepsTheFoldInsideAMovingRange) {
+  // Every material whose time constant is within a factor of two of
+  // response_s stays feasible through heating and cooling, in both modes.
+  for (double tau : {0.26, 0.35, 0.5, 0.9}) {
+    EXPECT_DOUBLE_EQ(worst_penalty_of_a_lagging_material(kHydrogel, tau, heat_and_cool(20, 32, 300)), 0.0) << tau;
+    EXPECT_DOUBLE_EQ(worst_penalty_of_a_lagging_material(kMetallic, tau, heat_and_cool(30, 40, 300)), 0.0) << tau;
+  }
+  // A material far slower than that is not.
+  EXPECT_GT(worst_penalty_of_a_lagging_material(kHydrogel, 3.0, heat_and_cool(20, 32, 300)), 0.0);
+
+  // The range moves with the fold: just after the trigger a folded gripper
+  // is infeasible (without response_s every fold up to 70 + 8 would be), and
+  // once the fold is done an open one is (it never unfolds).
+  auto s = make_stimulus(std::string(kMetallic) + "\nresponse_s = 0.5");
+  ramp(*s, 30.0, 38.0, 8, 0, 0.1);  // 37 C is passed at t = 0.7 s, then 0.1 s more
+  EXPECT_DOUBLE_EQ(s->penalty(std::vector<double>(2, 10.0)), 0.0);
+  EXPECT_GT(s->penalty(std::vector<double>(2, 65.0)), 0.0);
+  ramp(*s, 38.0, 30.0, 50, 1.0, 0.1);  // five seconds later, cooled again
+  EXPECT_DOUBLE_EQ(s->penalty(std::vector<double>(2, 65.0)), 0.0);
+  EXPECT_GT(s->penalty(std::vector<double>(2, 20.0)), 0.0);
+  auto plain = make_stimulus(kMetallic);
+  ramp(*plain, 30.0, 38.0, 8, 0, 0.1);
+  EXPECT_DOUBLE_EQ(plain->penalty(std::vector<double>(2, 65.0)), 0.0);
+  ramp(*plain, 38.0, 30.0, 50, 1.0, 0.1);
+  EXPECT_DOUBLE_EQ(plain->penalty(std::vector<double>(2, 20.0)), 0.0);
+}
+
 TEST(TemperatureHysteresis, BadTablesAreRejected) {
   EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nmode = \"sometimes\""), gtrack::ConfigError);
   EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nunfold_below_C = 30\nfold_above_C = 20"),
                gtrack::ConfigError);
   EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nfold_bias = 2"), gtrack::ConfigError);
+  EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nresponse_s = -1"), gtrack::ConfigError);
 }
 
 }  // namespace

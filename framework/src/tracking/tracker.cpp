@@ -373,6 +373,16 @@ struct Tracker::Impl {
     const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
     const Eigen::VectorXd s = spread() * spread_scale;
     Eigen::VectorXd start = from;
+    if (stimulus_on) {
+      // The swarm starts from joints the stimulus allows now: with a
+      // response time the allowed range moves with the fold, and a previous
+      // estimate left outside it would otherwise have to be walked back by
+      // the penalty alone.
+      const StimulusState st = setup.stimulus->state();
+      for (Eigen::Index d = kPoseDims; d < start.size(); ++d) {
+        start[d] = std::clamp(start[d], st.feasible_min_deg, st.feasible_max_deg);
+      }
+    }
     config.space.clamp(start);
     Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, pso_config.particles, config.space, rng);
     // Seen along the optical axis, a flat gripper tilted by (rx, ry) and by

@@ -17,6 +17,13 @@
 // band: for `settle_s` seconds after it enters the folded or unfolded range,
 // the joints are still allowed anywhere between the references (0 gives the
 // instantaneous rule).
+// With `response_s` > 0 the plugin also follows the material's response: the
+// fold the gripper can have reached is integrated from the readings as a
+// first-order lag towards target_joint_deg, with a time constant known within
+// a factor of two (response_s / 2 to 2 response_s). The joints are then
+// feasible within `tolerance_deg` of that interval, which replaces settle_s:
+// during a fold the allowed range moves with the fold instead of spanning
+// every value between the references.
 #include <algorithm>
 #include <cmath>
 #include <gtrack/plugin.hpp>
@@ -41,6 +48,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     smoothing_s_ = t.number_or("trend_smoothing_s", 2.0, Range::positive());
     fold_bias_ = t.number_or("fold_bias", 0.75, Range::closed(0.5, 1.0));
     settle_s_ = t.number_or("settle_s", 3.0, Range::non_negative());
+    response_s_ = t.number_or("response_s", 0.0, Range::non_negative());
     if (mode_ == "reversible" && !(unfold_below_ < fold_above_)) {
       t.fail("fold_above_C", "must be greater than unfold_below_C");
     }
@@ -61,6 +69,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
       prev_time_ = time_s;
       has_prev_ = true;
       if (mode_ == "latching" && value >= trigger_) triggered_ = true;
+      if (response_s_ > 0) follow_response(time_s);
     }
     refresh();
   }
@@ -114,6 +123,21 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
                                               : gtrack::StimulusTrend::Steady;
     low_ref_ = std::min(unfolded_, folded_);
     high_ref_ = std::max(unfolded_, folded_);
+    if (response_s_ > 0 && has_reach_) {
+      // The reachable folds, widened by the tolerance.
+      low_ref_ = reach_lo_;
+      high_ref_ = reach_hi_;
+      state_.feasible_min_deg = reach_lo_ - tolerance_;
+      state_.feasible_max_deg = reach_hi_ + tolerance_;
+      if (mode_ == "latching") {
+        state_.in_transition = triggered_;
+        if (triggered_) state_.trend = gtrack::StimulusTrend::Folding;
+      } else {
+        state_.in_transition = (T > unfold_below_ - kBandMarginC && T < fold_above_ + kBandMarginC) ||
+                               reach_hi_ - reach_lo_ > tolerance_;
+      }
+      return;
+    }
     if (mode_ == "latching") {
       state_.in_transition = triggered_;
       if (triggered_) {
@@ -128,7 +152,9 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     }
     state_.in_transition = T > unfold_below_ - kBandMarginC && T < fold_above_ + kBandMarginC;
     const int region = T >= fold_above_ ? 1 : T <= unfold_below_ ? -1 : 0;
-    if (region != region_) {
+    // Regions are counted from the first reading (not from the constructor's
+    // placeholder value), so that a sequence starting hot starts settled.
+    if (has_prev_ && region != region_) {
       if (region_ != 2) first_region_ = false;
       region_ = region;
       region_since_ = now_;
@@ -145,6 +171,38 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     }
   }
 
+  // One step of the response: each end of the reachable interval moves
+  // towards its target, the upper end fast when folding up and slowly when
+  // coming down, the lower end the other way round, so that every material
+  // whose time constant lies in [response_s / 2, 2 response_s] stays inside.
+  void follow_response(double time_s) {
+    const bool latched_unfolded = mode_ == "latching" && !triggered_;
+    if (!has_reach_) {
+      // A sequence that starts cold starts unfolded, one that starts hot
+      // folded (as with settle_s); otherwise the fold is not known yet.
+      const double T = state_.value;
+      const bool cold = latched_unfolded || (mode_ == "reversible" && T <= unfold_below_);
+      const bool hot = mode_ == "reversible" && T >= fold_above_;
+      reach_lo_ = cold ? unfolded_ : hot ? folded_ : std::min(unfolded_, folded_);
+      reach_hi_ = cold ? unfolded_ : hot ? folded_ : std::max(unfolded_, folded_);
+      has_reach_ = true;
+      reach_time_ = time_s;
+      return;
+    }
+    const double dt = time_s - reach_time_;
+    if (dt <= 0) return;
+    reach_time_ = time_s;
+    auto step = [&](double q, bool upper) {
+      const double target = target_joint_deg(q);
+      const bool fast = (target > q) == upper;
+      const double tau = fast ? 0.5 * response_s_ : 2.0 * response_s_;
+      return q + (target - q) * (1 - std::exp(-dt / tau));
+    };
+    const double lo = step(reach_lo_, false), hi = step(reach_hi_, true);
+    reach_lo_ = std::min(lo, hi);
+    reach_hi_ = std::max(lo, hi);
+  }
+
   void set_band(double ref) {
     state_.feasible_min_deg = ref - tolerance_;
     state_.feasible_max_deg = ref + tolerance_;
@@ -156,6 +214,9 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
   gtrack::StimulusState state_;
   double low_ref_ = 0, high_ref_ = 0;
   double settle_s_ = 3.0;
+  double response_s_ = 0.0;
+  double reach_lo_ = 0, reach_hi_ = 0, reach_time_ = 0;
+  bool has_reach_ = false;
   double prev_time_ = 0, now_ = 0, region_since_ = 0;
   int region_ = 2;            // none yet
   bool first_region_ = true;  // a sequence that starts hot or cold starts settled
