@@ -61,9 +61,12 @@ struct CostWeights {
   double kinematic = 0.15;  // lambda_K
   double stimulus = 1.0;    // lambda_S
   // lambda_T: weight of the temporal term T, the mean squared distance of a
-  // hypothesis to the constant-velocity prediction in units of
-  // [tracker] init_spread (a diagonal Mahalanobis distance). 0 = paper.
-  double temporal = 0.0;
+  // hypothesis's pose to the constant-velocity prediction in units of
+  // [tracker] init_spread (a diagonal Mahalanobis distance over the six pose
+  // parameters). A tie-breaker: under occlusion many poses explain O equally
+  // well. With lambda_T > 0, particle 1 of the swarm also starts at the
+  // prediction. 0 = paper.
+  double temporal = 0.001;
   // occlusion_discount in [0, 1]: when |O| falls below the area of the model
   // rendered at the previous estimate (ratio r < 1), rendered pixels outside
   // O are weighted w = 1 - occlusion_discount * (1 - r) in D (see cost.hpp).

@@ -54,6 +54,9 @@ struct Tracker::Impl {
   static constexpr double kRedetectGain = 0.7;
   // Spread multiplier of the re-detection's local swarm.
   static constexpr double kWideSpread = 3.0;
+  // A stimulus whose allowed joint range is wider than this (the defaults
+  // are +-1e9) says nothing about the fold.
+  static constexpr double kUnboundedJointRangeDeg = 1e6;
   bool started = false;  // a frame has been processed since construction or reset
   int last_frame = -1;   // the last frame processed
   int lost = 0;          // consecutive lost frames
@@ -78,6 +81,18 @@ struct Tracker::Impl {
     s.head<kPoseDims>() = t.head<kPoseDims>();
     s.tail(dims - kPoseDims).setConstant(t[6]);
     return s;
+  }
+
+  // The temporal term's scales: the pose's spreads, and 0 for the joints,
+  // which T leaves out (they follow the stimulus, not a velocity).
+  Eigen::VectorXd temporal_sigma() const {
+    Eigen::VectorXd s = spread();
+    s.tail(s.size() - kPoseDims).setZero();
+    return s;
+  }
+
+  void set_temporal_prediction(const Eigen::VectorXd& prediction) {
+    cost->set_prediction(prediction, temporal_sigma(), config.space.periodic.size() > 5 && config.space.periodic[5]);
   }
 
   // Something to report before anything was ever found.
@@ -139,9 +154,9 @@ struct Tracker::Impl {
     // smaller than the model at the previous estimate, the weight of rendered
     // pixels outside O and the area of them taken as hidden (the budget).
     std::optional<Eigen::VectorXd> prediction;
-    if (!searching) prediction = predict();
+    if (!searching) prediction = predict(stimulus_on);
     if (prediction && config.cost.temporal > 0) {
-      cost->set_prediction(*prediction, spread(), config.space.periodic.size() > 5 && config.space.periodic[5]);
+      set_temporal_prediction(*prediction);
     } else {
       cost->clear_prediction();
     }
@@ -230,9 +245,7 @@ struct Tracker::Impl {
               found.cost = wide.best_cost;
             }
           }
-          if (predicting) {
-            cost->set_prediction(*prediction, spread(), config.space.periodic.size() > 5 && config.space.periodic[5]);
-          }
+          if (predicting) set_temporal_prediction(*prediction);
           const CostTerms alternative = score(found.best);
           const double lt = config.cost.temporal;
           // Compared without the temporal term: the point is to leave the
@@ -346,17 +359,28 @@ struct Tracker::Impl {
     return detail::coarse_search(in, config, *cost, rng);
   }
 
-  // Constant velocity: last + (last - before_last), rz the short way; the
-  // last estimate itself when there is no velocity yet.
-  Eigen::VectorXd predict() const {
+  // The pose at constant velocity: last + (last - before_last), rz the short
+  // way; the last pose itself when there is no velocity yet. The joints are
+  // not extrapolated: they take the middle of the range the stimulus allows
+  // now (with a response time, the fold the material can have reached), or
+  // stay at the last estimate when there is no stimulus.
+  Eigen::VectorXd predict(bool stimulus_on) const {
     Eigen::VectorXd p = *last;
     if (before_last && before_last->size() == last->size()) {
       Eigen::VectorXd v = *last - *before_last;
+      v.tail(v.size() - kPoseDims).setZero();
       if (v.size() > 5) v[5] = std::remainder(v[5], 360.0);
       // Depth is seen too weakly for its frame-to-frame change to be a
       // velocity (it is mostly noise): it is predicted to stay.
       v[2] = 0;
       p += v;
+    }
+    if (stimulus_on) {
+      const StimulusState st = setup.stimulus->state();
+      if (std::isfinite(st.feasible_min_deg) && std::isfinite(st.feasible_max_deg) &&
+          st.feasible_max_deg - st.feasible_min_deg < kUnboundedJointRangeDeg) {
+        p.tail(p.size() - kPoseDims).setConstant(0.5 * (st.feasible_min_deg + st.feasible_max_deg));
+      }
     }
     config.space.clamp(p);
     return p;
