@@ -54,6 +54,11 @@ run_setup() {  # run_setup NAME CONFIG FRAMES MAX_INPLANE_UM MAX_ORIENT_DEG MAX_
 # exactly orthographic: the tilt's sign is not in the image, so orientation is
 # not held to a bound here (nor is depth, which it does not image).
 run_setup examples examples/example_setup.toml 30 "${EXAMPLE_MAX_UM:-60}" "${EXAMPLE_MAX_DEG:-180}" "${EXAMPLE_MAX_JOINT_DEG:-15}"
+# The TOML-defined gripper is 2.9 mm across: a lost track is off by a
+# millimetre or more. On this one 60-frame sequence the swarm's seed alone
+# moves the in-plane error between about 30 and 210 um (docs/RESULTS.md, "How
+# much the swarm's own seed moves these numbers"), so the bound sits above
+# that spread.
 run_setup custom_gripper "$prefix/share/gtrack/configs/microscope_custom_gripper.toml" 60 \
-  "${CUSTOM_MAX_UM:-100}" "${CUSTOM_MAX_DEG:-30}" "${CUSTOM_MAX_JOINT_DEG:-10}"
+  "${CUSTOM_MAX_UM:-250}" "${CUSTOM_MAX_DEG:-30}" "${CUSTOM_MAX_JOINT_DEG:-10}"
 echo "ci_examples: passed"
