@@ -117,40 +117,32 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
  private:
   void refresh() {
     const double T = state_.value;
-    const double lo = std::min(unfolded_, folded_) - tolerance_, hi = std::max(unfolded_, folded_) + tolerance_;
     state_.trend = state_.rate > min_rate_    ? gtrack::StimulusTrend::Folding
                    : state_.rate < -min_rate_ ? gtrack::StimulusTrend::Unfolding
                                               : gtrack::StimulusTrend::Steady;
-    low_ref_ = std::min(unfolded_, folded_);
-    high_ref_ = std::max(unfolded_, folded_);
+    const bool latching = mode_ == "latching";
+    if (latching) {
+      state_.in_transition = triggered_;
+      // Folding is still under way: the trend is folding while triggered.
+      if (triggered_) state_.trend = gtrack::StimulusTrend::Folding;
+    } else {
+      state_.in_transition = T > unfold_below_ - kBandMarginC && T < fold_above_ + kBandMarginC;
+    }
     if (response_s_ > 0 && has_reach_) {
       // The reachable folds, widened by the tolerance.
-      low_ref_ = reach_lo_;
-      high_ref_ = reach_hi_;
-      state_.feasible_min_deg = reach_lo_ - tolerance_;
-      state_.feasible_max_deg = reach_hi_ + tolerance_;
-      if (mode_ == "latching") {
-        state_.in_transition = triggered_;
-        if (triggered_) state_.trend = gtrack::StimulusTrend::Folding;
-      } else {
-        state_.in_transition = (T > unfold_below_ - kBandMarginC && T < fold_above_ + kBandMarginC) ||
-                               reach_hi_ - reach_lo_ > tolerance_;
-      }
+      set_range(reach_lo_, reach_hi_);
+      if (!latching && reach_hi_ - reach_lo_ > tolerance_) state_.in_transition = true;
       return;
     }
-    if (mode_ == "latching") {
-      state_.in_transition = triggered_;
+    const double open_or_closed_lo = std::min(unfolded_, folded_), open_or_closed_hi = std::max(unfolded_, folded_);
+    if (latching) {
       if (triggered_) {
-        state_.feasible_min_deg = lo;
-        state_.feasible_max_deg = hi;
-        // Folding is still under way: the trend is folding while triggered.
-        state_.trend = gtrack::StimulusTrend::Folding;
+        set_range(open_or_closed_lo, open_or_closed_hi);
       } else {
         set_band(unfolded_);
       }
       return;
     }
-    state_.in_transition = T > unfold_below_ - kBandMarginC && T < fold_above_ + kBandMarginC;
     const int region = T >= fold_above_ ? 1 : T <= unfold_below_ ? -1 : 0;
     // Regions are counted from the first reading (not from the constructor's
     // placeholder value), so that a sequence starting hot starts settled.
@@ -165,8 +157,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     } else if (region == -1 && settled) {
       set_band(unfolded_);
     } else {
-      state_.feasible_min_deg = lo;
-      state_.feasible_max_deg = hi;
+      set_range(open_or_closed_lo, open_or_closed_hi);
       if (region != 0) state_.in_transition = true;
     }
   }
@@ -203,11 +194,16 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     reach_hi_ = std::max(lo, hi);
   }
 
-  void set_band(double ref) {
-    state_.feasible_min_deg = ref - tolerance_;
-    state_.feasible_max_deg = ref + tolerance_;
-    low_ref_ = high_ref_ = ref;
+  // Joints within tolerance_deg of [lo_ref, hi_ref] are feasible; the
+  // penalty of the others is taken against the nearer reference.
+  void set_range(double lo_ref, double hi_ref) {
+    state_.feasible_min_deg = lo_ref - tolerance_;
+    state_.feasible_max_deg = hi_ref + tolerance_;
+    low_ref_ = lo_ref;
+    high_ref_ = hi_ref;
   }
+
+  void set_band(double ref) { set_range(ref, ref); }
 
   std::string mode_;
   double unfold_below_, fold_above_, trigger_, unfolded_, folded_, tolerance_, min_rate_, smoothing_s_, fold_bias_;
