@@ -111,9 +111,8 @@ struct Tracker::Impl {
     const auto& g = setup.model().geometry();
     double lo = std::max(g.joint_min_deg, std::min(g.unfolded_deg, g.folded_deg));
     double hi = std::min(g.joint_max_deg, std::max(g.unfolded_deg, g.folded_deg));
-    if (stimulus_on) {
-      const StimulusState st = setup.stimulus->state();
-      const double flo = std::max(lo, st.feasible_min_deg), fhi = std::min(hi, st.feasible_max_deg);
+    if (const auto allowed = stimulus_joints(stimulus_on)) {
+      const double flo = std::max(lo, allowed->first), fhi = std::min(hi, allowed->second);
       if (flo <= fhi) {
         lo = flo;
         hi = fhi;
@@ -375,15 +374,21 @@ struct Tracker::Impl {
       v[2] = 0;
       p += v;
     }
-    if (stimulus_on) {
-      const StimulusState st = setup.stimulus->state();
-      if (std::isfinite(st.feasible_min_deg) && std::isfinite(st.feasible_max_deg) &&
-          st.feasible_max_deg - st.feasible_min_deg < kUnboundedJointRangeDeg) {
-        p.tail(p.size() - kPoseDims).setConstant(0.5 * (st.feasible_min_deg + st.feasible_max_deg));
-      }
+    const auto allowed = stimulus_joints(stimulus_on);
+    if (allowed && std::isfinite(allowed->first) && std::isfinite(allowed->second) &&
+        allowed->second - allowed->first < kUnboundedJointRangeDeg) {
+      p.tail(p.size() - kPoseDims).setConstant(0.5 * (allowed->first + allowed->second));
     }
     config.space.clamp(p);
     return p;
+  }
+
+  // The joint range the stimulus allows now (StimulusState's feasible range;
+  // +-1e9 from a stimulus that does not bound them), none without a stimulus.
+  std::optional<std::pair<double, double>> stimulus_joints(bool stimulus_on) const {
+    if (!stimulus_on) return std::nullopt;
+    const StimulusState st = setup.stimulus->state();
+    return std::make_pair(st.feasible_min_deg, st.feasible_max_deg);
   }
 
   Eigen::VectorXd optimise(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng,
@@ -397,14 +402,13 @@ struct Tracker::Impl {
     const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
     const Eigen::VectorXd s = spread() * spread_scale;
     Eigen::VectorXd start = from;
-    if (stimulus_on) {
+    if (const auto allowed = stimulus_joints(stimulus_on)) {
       // The swarm starts from joints the stimulus allows now: with a
       // response time the allowed range moves with the fold, and a previous
       // estimate left outside it would otherwise have to be walked back by
       // the penalty alone.
-      const StimulusState st = setup.stimulus->state();
       for (Eigen::Index d = kPoseDims; d < start.size(); ++d) {
-        start[d] = std::clamp(start[d], st.feasible_min_deg, st.feasible_max_deg);
+        start[d] = std::clamp(start[d], allowed->first, allowed->second);
       }
     }
     config.space.clamp(start);
