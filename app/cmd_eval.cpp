@@ -26,25 +26,48 @@ void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) 
             << "  max " << std::setw(8) << s.max << " " << unit << "\n";
 }
 
-// The occlusion allowance per frame, from the estimates.jsonl beside the
-// estimates (empty when there is none).
-std::map<int, double> allowances(const fs::path& estimates_csv) {
-  std::map<int, double> out;
+// What estimates.jsonl says of a frame: the occlusion allowance, and, from
+// 'gtrack track --score-truth', the estimate's and the truth's costs and how
+// much of the truth's silhouette fell outside O.
+struct FrameScores {
+  double allowance = 0;
+  std::optional<double> cost, reference_cost, reference_outside;
+};
+
+// Per frame, from the estimates.jsonl beside the estimates (empty when there
+// is none).
+std::map<int, FrameScores> frame_scores(const fs::path& estimates_csv) {
+  std::map<int, FrameScores> out;
   std::ifstream in(estimates_csv.parent_path() / "estimates.jsonl");
   for (std::string line; std::getline(in, line);) {
-    const auto field = [&](const std::string& key) -> std::optional<double> {
-      const auto at = line.find("\"" + key + "\":");
+    const auto field = [&](const std::string& text, const std::string& key) -> std::optional<double> {
+      const auto at = text.find("\"" + key + "\":");
       if (at == std::string::npos) return std::nullopt;
       char* end = nullptr;
-      const char* start = line.c_str() + at + key.size() + 3;
+      const char* start = text.c_str() + at + key.size() + 3;
       const double v = std::strtod(start, &end);
       return end == start ? std::nullopt : std::optional<double>(v);
     };
-    const auto frame = field("frame"), allowance = field("outside_allowance");
-    if (frame && allowance) out[static_cast<int>(*frame)] = *allowance;
+    const auto ref_at = line.find("\"reference\":{");
+    const std::string own = line.substr(0, ref_at);
+    const auto frame = field(own, "frame"), allowance = field(own, "outside_allowance");
+    if (!frame || !allowance) continue;
+    FrameScores& s = out[static_cast<int>(*frame)];
+    s.allowance = *allowance;
+    s.cost = field(own, "cost");
+    if (ref_at != std::string::npos) {
+      const std::string ref = line.substr(ref_at, line.find('}', ref_at) - ref_at);
+      s.reference_cost = field(ref, "cost");
+      const auto rendered = field(ref, "rendered_pixels"), overlap = field(ref, "overlap_pixels");
+      if (rendered && overlap) s.reference_outside = *rendered - *overlap;
+    }
   }
   return out;
 }
+
+// A truth that scores lower than the estimate by more than this is one the
+// search missed.
+constexpr double kLowerBy = 1e-4;
 
 // --breakdown: the in-view frames with an estimate, grouped by how much of
 // the gripper the truth says was hidden, and the unoccluded ones by whether
@@ -57,10 +80,14 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     const auto it = r.extra.find(key);
     return it == r.extra.end() ? std::optional<double>() : std::optional<double>(it->second);
   };
-  const auto allowance = allowances(estimates_csv);
+  const auto scores = frame_scores(estimates_csv);
   std::map<std::string, gtrack::ErrorSet> groups;
   const std::vector<std::string> order = {"unoccluded", "< 40 % hidden", ">= 40 % hidden", "partly out of view",
                                           "unoccluded, no allowance", "unoccluded, an allowance left"};
+  // With the truth scored (--score-truth): is the search or the cost short?
+  const std::vector<std::string> why = {"truth scores lower", "truth spills over allowance", "truth scores no lower"};
+  std::map<std::string, double> inplane_sum;
+  double inplane_total = 0;
   bool have_occlusion = false;
   for (const auto& f : ev.per_frame) {
     if (f.out_of_view || !f.has_estimate || f.lost) continue;
@@ -72,17 +99,28 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     std::string g = *occluded < 0.01 ? order[0] : *occluded < 0.4 ? order[1] : order[2];
     if (f.in_view < 0.99) g = order[3];
     groups[g].add(f.errors);
-    if (g == order[0]) {
-      const auto a = allowance.find(f.frame);
-      if (a != allowance.end()) groups[a->second > 0 ? order[5] : order[4]].add(f.errors);
+    const auto s = scores.find(f.frame);
+    if (g == order[0] && s != scores.end()) groups[s->second.allowance > 0 ? order[5] : order[4]].add(f.errors);
+    if (s != scores.end() && s->second.cost && s->second.reference_cost) {
+      const FrameScores& fs = s->second;
+      const std::string& w = *fs.reference_cost < *fs.cost - kLowerBy ? why[0]
+                             : fs.allowance > 0 && fs.reference_outside && *fs.reference_outside > fs.allowance
+                                 ? why[1]
+                                 : why[2];
+      groups[w].add(f.errors);
+      inplane_sum[w] += f.errors.inplane_um;
+      inplane_total += f.errors.inplane_um;
     }
   }
   if (!have_occlusion) {
     std::cout << "  breakdown: the truth has no 'occluded' column (gtrack synth writes one)\n";
     return;
   }
-  std::cout << "  breakdown (in-view frames with an estimate; the allowance rows need estimates.jsonl):\n";
-  for (const auto& name : order) {
+  std::cout << "  breakdown (in-view frames with an estimate; the allowance rows need estimates.jsonl, the last "
+               "three 'gtrack track --score-truth'):\n";
+  std::vector<std::string> all = order;
+  all.insert(all.end(), why.begin(), why.end());
+  for (const auto& name : all) {
     auto it = groups.find(name);
     if (it == groups.end()) continue;
     gtrack::ErrorSet& e = it->second;
@@ -91,7 +129,12 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
               << e.position_inplane_um.count << " frames  in-plane " << std::setprecision(1) << std::setw(7)
               << e.position_inplane_um.mean << " um (median " << e.position_inplane_um.median << ")  orientation "
               << std::setw(5) << e.orientation_deg.mean << " deg (median " << e.orientation_deg.median
-              << ")  joints " << std::setprecision(2) << e.joint_deg.mean << " deg\n";
+              << ")  joints " << std::setprecision(2) << e.joint_deg.mean << " deg";
+    if (inplane_sum.count(name) && inplane_total > 0) {
+      std::cout << "  (" << std::setprecision(0) << 100 * inplane_sum[name] / inplane_total
+                << " % of the summed in-plane error)";
+    }
+    std::cout << "\n";
   }
 }
 
@@ -193,8 +236,9 @@ GTRACK_COMMAND(
           "config,c", po::value<std::string>(), "config naming the gripper (default: sequence.toml beside the truth)")(
           "json", po::value<std::string>(), "write the summary as JSON")(
           "per-frame", po::value<std::string>(), "write per-frame errors as CSV")(
-          "breakdown", "also the errors by how much of the gripper was hidden, and of unoccluded frames by "
-                       "whether an occlusion allowance was left over")(
+          "breakdown", "also the errors by how much of the gripper was hidden, of unoccluded frames by "
+                       "whether an occlusion allowance was left over, and (after 'gtrack track --score-truth') by "
+                       "whether the truth scored lower than the estimate")(
           "out-of-view-below", po::value<double>()->default_value(0.1, "0.1"),
           "share of the gripper inside the image under which a frame counts as out of view")(
           "off-track-um", po::value<double>()->default_value(400.0, "400"),

@@ -57,6 +57,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.resume = vm.count("resume") > 0;
   opt.follow_stimulus = vm.count("follow-stimulus") > 0;
   if (vm.count("restart-from")) opt.restart_from = vm["restart-from"].as<std::string>();
+  if (vm.count("score-truth")) opt.score_truth = vm["score-truth"].as<std::string>();
   if (vm.count("follow-input")) {
     opt.follow_input_s = vm["follow-input"].as<double>();
     if (!(opt.follow_input_s > 0)) throw gtrack::cli::UsageError("--follow-input: expected seconds > 0");
@@ -120,6 +121,9 @@ GTRACK_COMMAND(
           "SECONDS: the input folder is still being written: track new images as they arrive, end after SECONDS "
           "without one")(
           "restart-from", po::value<std::string>(),
-          "pose table (e.g. ground_truth.csv): before each frame, set the track to its row for the previous frame");
+          "pose table (e.g. ground_truth.csv): before each frame, set the track to its row for the previous frame")(
+          "score-truth", po::value<std::string>(),
+          "pose table (e.g. ground_truth.csv): score its row for each frame as the estimate was scored, and write "
+          "it beside the estimate in estimates.jsonl (\"reference\")");
     },
     run_track)

@@ -212,6 +212,9 @@ TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {
   const CliRun r =
       gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out").string() + " --restart-from " + table.string());
   expect_refusal(r, table.string() + ": has 2 joint columns, the gripper of this config has 6");
+  const CliRun s =
+      gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out2").string() + " --score-truth " + table.string());
+  expect_refusal(s, table.string() + ": has 2 joint columns, the gripper of this config has 6");
 }
 
 int count_files(const fs::path& dir, const std::string& extension) {
@@ -369,15 +372,24 @@ TEST(Cli, EvalRefusesMalformedTables) {
 }
 
 // eval --breakdown: every in-view frame with an estimate falls in exactly
-// one occlusion group, and the unoccluded ones again by the allowance.
+// one occlusion group, the unoccluded ones again by the allowance, and, with
+// the truth scored by the track (--score-truth), every frame in exactly one
+// of the three groups that say whether the truth scored lower.
 TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "breakdown";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 20 --seed 2 --out " + dir.string()).code, 0);
   ASSERT_EQ(
-      gtrack(track_of(dir) + " -s " + (dir / "stimulus.csv").string() + " --no-overlay -o " + (dir / "out").string())
+      gtrack(track_of(dir) + " -s " + (dir / "stimulus.csv").string() + " --no-overlay -o " + (dir / "out").string() +
+             " --score-truth " + (dir / "ground_truth.csv").string())
           .code,
       0);
+  {
+    std::ifstream jsonl(dir / "out" / "estimates.jsonl");
+    int with_reference = 0;
+    for (std::string l; std::getline(jsonl, l);) with_reference += l.find("\"reference\":{\"cost\":") != std::string::npos;
+    EXPECT_EQ(with_reference, 20);
+  }
   const CliRun r = gtrack("eval -t " + (dir / "ground_truth.csv").string() + " -e " +
                           (dir / "out" / "estimates.csv").string() + " --breakdown");
   ASSERT_EQ(r.code, 0) << r.output;
@@ -400,6 +412,9 @@ TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   EXPECT_EQ(groups["unoccluded, no allowance"] + groups["unoccluded, an allowance left"], groups["unoccluded"])
       << r.output;
   EXPECT_GT(groups["unoccluded"], 0) << r.output;
+  EXPECT_EQ(groups["truth scores lower"] + groups["truth spills over allowance"] + groups["truth scores no lower"],
+            evaluated)
+      << r.output;
 }
 
 TEST(Cli, UsageErrors) {

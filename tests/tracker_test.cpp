@@ -439,6 +439,33 @@ TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
   EXPECT_DOUBLE_EQ(t.outside_allowance, 0.0);
 }
 
+// Tracker::score (gtrack track --score-truth): a configuration scored after
+// a frame gets exactly the terms the estimate got, allowance and temporal
+// term included, and another configuration scores worse.
+TEST(Tracker, ScoreRepeatsTheFramesCost) {
+  auto setup = make_setup();
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  EXPECT_THROW(tracker.score(truth), gtrack::Error);  // no frame yet
+  tracker.set_estimate(truth);
+  tracker.process(scene(setup, truth, 1), 0, 0.0, 26.0);
+  tracker.process(scene(setup, truth, 2), 1, 1 / 30.0, 26.0);
+  const auto e = tracker.process(half_covered(tracker, setup, truth, 3), 2, 2 / 30.0, 26.0);
+  ASSERT_GT(e.outside_allowance, 0.0);  // the budget is part of what is repeated
+  ASSERT_GT(e.terms.temporal, 0.0);     // and the temporal term
+  const gtrack::CostTerms again = tracker.score(e.hypothesis);
+  EXPECT_DOUBLE_EQ(again.total, e.terms.total);
+  EXPECT_DOUBLE_EQ(again.dice, e.terms.dice);
+  EXPECT_DOUBLE_EQ(again.temporal, e.terms.temporal);
+  EXPECT_EQ(again.rendered, e.terms.rendered);
+  EXPECT_EQ(again.overlap, e.terms.overlap);
+  EXPECT_GT(again.rendered, again.overlap);  // half of it is hidden
+  Eigen::VectorXd off = e.hypothesis;
+  off[0] += 0.3;
+  EXPECT_GT(tracker.score(off).total, e.terms.total + 0.05);
+  EXPECT_THROW(tracker.score(e.hypothesis.head(8)), gtrack::Error);
+}
+
 // [tracker] redetect_dice: a track that sits on a wrong configuration while
 // the gripper is in plain view is replaced by the coarse search's result.
 TEST(Tracker, RedetectionReplacesAWrongTrack) {

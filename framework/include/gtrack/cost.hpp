@@ -27,6 +27,10 @@ struct CostTerms {
   double stimulus = 0;   // S
   double temporal = 0;   // T (0 when no prediction is set)
   double total = 0;      // E
+  // |P| and |O&P| in render pixels (summed over the views): P\O, what the
+  // hypothesis shows where nothing was observed, is rendered - overlap.
+  std::uint64_t rendered = 0;
+  std::uint64_t overlap = 0;
 };
 
 // D from counts. An empty observation and an empty hypothesis agree

@@ -75,6 +75,10 @@ struct Estimate {
   std::uint64_t evaluations = 0;      // hypotheses scored for this frame
   bool redetected = false;            // the coarse search's result replaced the tracked one
   bool mirrored = false;              // the tilt mirror of the result scored lower and replaced it
+  // A reference configuration (TrackOptions::score_truth) scored on this
+  // frame exactly as the estimate was: same observation, allowance,
+  // temporal prediction and stimulus.
+  std::optional<CostTerms> reference_terms;
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
 };
@@ -112,6 +116,10 @@ class GTRACK_API Tracker {
 
   // The observation of the last processed frame (render size, 0/255).
   const Observation& last_observation() const;
+  // A configuration scored on the last processed frame as its estimate was:
+  // the same observation, occlusion allowance, temporal prediction and
+  // stimulus state. Throws before the first frame.
+  CostTerms score(const Eigen::VectorXd& hypothesis);
   // The estimate drawn on a frame: posed triangles projected with
   // Sensor::project and filled in green with alpha, plus the stimulus reading
   // in the bottom-right corner.
@@ -152,6 +160,13 @@ struct TrackOptions {
   // accumulates over a sequence. Frames whose previous row is missing are
   // tracked from the track as it is.
   std::optional<std::filesystem::path> restart_from;
+  // A pose table (ground_truth.csv): after each frame its row for that frame
+  // is scored as the estimate was (Tracker::score) and written beside it in
+  // estimates.jsonl ("reference"). A reference that scores lower than the
+  // estimate is a configuration the search missed; one that scores no lower
+  // is one the cost cannot prefer (docs/RESULTS.md, "Where the error comes
+  // from"). The track itself is not changed.
+  std::optional<std::filesystem::path> score_truth;
   std::function<void(const Estimate&)> on_frame;  // called after each frame is written
 };
 

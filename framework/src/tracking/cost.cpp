@@ -81,6 +81,8 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     }
     const std::uint64_t observed = r->observation_count();
     for (int i = 0; i < n; ++i) {
+      out[i].rendered += counts_[i].rendered;
+      out[i].overlap += std::min(counts_[i].intersection, counts_[i].rendered);
       out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_,
                                             outside_allowance_, outside_tolerance_, weights_.occlusion_growth_weight);
     }

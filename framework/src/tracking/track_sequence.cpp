@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -141,6 +143,17 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       restart_rows[row.frame] = row.h;
     }
   }
+  std::map<int, Eigen::VectorXd> reference_rows;
+  if (options.score_truth) {
+    const PoseTable table = read_pose_table(*options.score_truth);
+    if (table.fingers != setup.model().fingers()) {
+      throw InputError(options.score_truth->string() + ": has " + std::to_string(table.fingers) +
+                       " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
+    }
+    for (const auto& row : table.rows) {
+      if (row.h.allFinite()) reference_rows[row.frame] = row.h;
+    }
+  }
   if (options.stimulus_csv) {
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
   }
@@ -265,6 +278,24 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
     previous_index = frame->index;
+    if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
+      // Of the reference's symmetric equivalents (the same silhouette), the
+      // one whose angles are nearest the estimate's, so that the temporal
+      // term compares like with like.
+      const ArticulatedModel& model = setup.model();
+      Eigen::VectorXd reference = row->second;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
+        const Eigen::VectorXd h = model.symmetric_equivalent(row->second, k);
+        double d = 0;
+        for (int a = 3; a < kPoseDims; ++a) d += std::pow(std::remainder(h[a] - e.hypothesis[a], 360.0), 2);
+        if (d < nearest) {
+          nearest = d;
+          reference = h;
+        }
+      }
+      e.reference_terms = tracker.score(reference);
+    }
 
     const auto t_write = Clock::now();
     if (options.save_masks) {

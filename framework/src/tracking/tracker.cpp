@@ -496,6 +496,15 @@ void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
 
 const std::optional<Eigen::VectorXd>& Tracker::last_estimate() const { return impl_->last; }
 const Observation& Tracker::last_observation() const { return impl_->observation; }
+
+CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
+  if (!impl_->started) throw Error("tracker: score() needs a processed frame");
+  if (hypothesis.size() != impl_->config.space.dims()) {
+    throw Error("tracker: score() got " + std::to_string(hypothesis.size()) + " parameters, the model has " +
+                std::to_string(impl_->config.space.dims()));
+  }
+  return impl_->cost->evaluate_one(hypothesis);
+}
 Renderer& Tracker::renderer() { return *impl_->renderer; }
 const EngineConfig& Tracker::config() const { return impl_->config; }
 const ParameterSpace& Tracker::space() const { return impl_->config.space; }
