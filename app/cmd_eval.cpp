@@ -1,4 +1,5 @@
 // gtrack eval: estimates against ground truth (paper Section 5.1 metrics).
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -86,8 +87,6 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
                                           "unoccluded, no allowance", "unoccluded, an allowance left"};
   // With the truth scored (--score-truth): is the search or the cost short?
   const std::vector<std::string> why = {"truth scores lower", "truth spills over allowance", "truth scores no lower"};
-  std::map<std::string, double> inplane_sum;
-  double inplane_total = 0;
   bool have_occlusion = false;
   for (const auto& f : ev.per_frame) {
     if (f.out_of_view || !f.has_estimate || f.lost) continue;
@@ -108,8 +107,6 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
                                  ? why[1]
                                  : why[2];
       groups[w].add(f.errors);
-      inplane_sum[w] += f.errors.inplane_um;
-      inplane_total += f.errors.inplane_um;
     }
   }
   if (!have_occlusion) {
@@ -118,20 +115,28 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
   }
   std::cout << "  breakdown (in-view frames with an estimate; the allowance rows need estimates.jsonl, the last "
                "three 'gtrack track --score-truth'):\n";
+  for (auto& [name, e] : groups) e.finish();
+  // The three --score-truth groups split the same frames: each one's share of
+  // their summed in-plane error.
+  const auto inplane_sum = [&](const std::string& name) {
+    const auto it = groups.find(name);
+    return it == groups.end() ? 0.0 : it->second.position_inplane_um.mean * it->second.position_inplane_um.count;
+  };
+  double inplane_total = 0;
+  for (const auto& name : why) inplane_total += inplane_sum(name);
   std::vector<std::string> all = order;
   all.insert(all.end(), why.begin(), why.end());
   for (const auto& name : all) {
     auto it = groups.find(name);
     if (it == groups.end()) continue;
-    gtrack::ErrorSet& e = it->second;
-    e.finish();
+    const gtrack::ErrorSet& e = it->second;
     std::cout << "    " << std::left << std::setw(30) << name << std::right << std::setw(5)
               << e.position_inplane_um.count << " frames  in-plane " << std::setprecision(1) << std::setw(7)
               << e.position_inplane_um.mean << " um (median " << e.position_inplane_um.median << ")  orientation "
               << std::setw(5) << e.orientation_deg.mean << " deg (median " << e.orientation_deg.median
               << ")  joints " << std::setprecision(2) << e.joint_deg.mean << " deg";
-    if (inplane_sum.count(name) && inplane_total > 0) {
-      std::cout << "  (" << std::setprecision(0) << 100 * inplane_sum[name] / inplane_total
+    if (std::find(why.begin(), why.end(), name) != why.end() && inplane_total > 0) {
+      std::cout << "  (" << std::setprecision(0) << 100 * inplane_sum(name) / inplane_total
                 << " % of the summed in-plane error)";
     }
     std::cout << "\n";

@@ -114,6 +114,16 @@ int expected_frames(const FrameSource& src, const FrameRange& r) {
   return (n - r.first + r.every - 1) / r.every;
 }
 
+// A pose table (--restart-from, --score-truth) for the gripper of this setup.
+PoseTable read_gripper_poses(const fs::path& file, const Setup& setup) {
+  PoseTable table = read_pose_table(file);
+  if (table.fingers != setup.model().fingers()) {
+    throw InputError(file.string() + ": has " + std::to_string(table.fingers) +
+                     " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
+  }
+  return table;
+}
+
 }  // namespace
 
 TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
@@ -130,11 +140,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   std::map<int, Eigen::VectorXd> restart_rows;
   if (options.restart_from) {
-    const PoseTable table = read_pose_table(*options.restart_from);
-    if (table.fingers != setup.model().fingers()) {
-      throw InputError(options.restart_from->string() + ": has " + std::to_string(table.fingers) +
-                       " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
-    }
+    const PoseTable table = read_gripper_poses(*options.restart_from, setup);
     for (const auto& row : table.rows) {
       if (!row.h.allFinite()) {
         throw InputError(options.restart_from->string() + ": frame " + std::to_string(row.frame) +
@@ -145,11 +151,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   std::map<int, Eigen::VectorXd> reference_rows;
   if (options.score_truth) {
-    const PoseTable table = read_pose_table(*options.score_truth);
-    if (table.fingers != setup.model().fingers()) {
-      throw InputError(options.score_truth->string() + ": has " + std::to_string(table.fingers) +
-                       " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
-    }
+    const PoseTable table = read_gripper_poses(*options.score_truth, setup);
     for (const auto& row : table.rows) {
       if (row.h.allFinite()) reference_rows[row.frame] = row.h;
     }
