@@ -37,6 +37,7 @@ void run(benchmark::State& state, const Factory& make, int threads) {
   renderer->set_model(s.model);
   renderer->set_projection(s.projection, s.scale);
   renderer->set_observation(s.observation);
+  renderer->set_rim(s.rim);
   constexpr int kBatch = 32, kBatches = 64;
   const Eigen::MatrixXd all = gtrack::bench_hypotheses(s, kBatch * kBatches, 1);
   std::vector<Eigen::MatrixXd> batches;

@@ -16,6 +16,7 @@ class CountsRenderer final : public gtrack::Renderer {
   void set_projection(const gtrack::Projection&, double) override {}
   gtrack::ImageSize render_size() const override { return {8, 8}; }
   void set_observation(const cv::Mat&) override {}
+  void set_rim(const cv::Mat&) override {}
   std::uint64_t observation_count() const override { return observed; }
   void submit(const Eigen::MatrixXd& h) override {
     ++submitted;
@@ -202,6 +203,45 @@ TEST(Cost, OccludedTruePoseBeatsShrunkenModelWithOutsideAllowance) {
   EXPECT_LT(t[0].total, t[1].total);
   eval.set_outside_allowance(-3);  // clamped
   EXPECT_DOUBLE_EQ(eval.outside_allowance(), 0.0);
+}
+
+TEST(Cost, RimPixelsAreNeverTakenAsHidden) {
+  // O = 50 pixels of a 100-pixel model, allowance 50. The true pose spills
+  // 50 pixels, 5 of them in the rim (along the occluder's edge): 45 are
+  // allowed, the 5 count.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50, 0, 0, 5), 1.0 - 100.0 / 105.0);
+  // A model placed loosely around O spills the same 50 pixels, 30 of them
+  // along the visible outline: it pays for those 30.
+  const double loose = gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50, 0, 0, 30);
+  EXPECT_DOUBLE_EQ(loose, 1.0 - 100.0 / 130.0);
+  EXPECT_GT(loose, gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50, 0, 0, 5));
+  // The allowance and its tolerance cover the other P\O pixels: 70 outside,
+  // 10 in the rim, 60 others = 50 allowed + 10 in the tolerance at 0.5.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 120, 1.0, 50, 10, 0.5, 10), 1.0 - 100.0 / 115.0);
+  // A rim count above |P\O| counts no more than P\O.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(50, 50, 100, 1.0, 50, 0, 0, 500), gtrack::dice_distance(50, 50, 100));
+  // Without an allowance every P\O pixel counts anyway: the rim changes nothing.
+  EXPECT_DOUBLE_EQ(gtrack::weighted_dice_distance(45, 50, 60, 1.0, 0, 0, 0, 7), gtrack::dice_distance(45, 50, 60));
+}
+
+TEST(Cost, EvaluatorUsesTheRimCountsOnlyWhenAsked) {
+  CountsRenderer r;
+  r.observed = 50;
+  gtrack::PairCounts tight{50, 100, 5}, loose{50, 100, 30};
+  r.counts = {tight, loose};
+  FixedGripper g;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, gtrack::CostWeights{});
+  eval.set_outside_allowance(50);
+  const Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  std::vector<gtrack::CostTerms> t;
+  eval.evaluate(h, t);
+  EXPECT_DOUBLE_EQ(t[0].dice, 0.0);  // the budget alone cannot tell them apart
+  EXPECT_DOUBLE_EQ(t[1].dice, 0.0);
+  eval.set_use_rim(true);
+  eval.evaluate(h, t);
+  EXPECT_DOUBLE_EQ(t[0].dice, 1.0 - 100.0 / 105.0);
+  EXPECT_DOUBLE_EQ(t[1].dice, 1.0 - 100.0 / 130.0);
+  EXPECT_LT(t[0].total, t[1].total);
 }
 
 TEST(Cost, TemporalTermIsMahalanobisToThePrediction) {

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <new>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
@@ -201,6 +202,53 @@ TEST(CpuRenderer, CountsAreIntersectionAndRenderedOfTheMasks) {
   }
   // The nominal pose is the observation minus the speckle.
   EXPECT_EQ(got[0].intersection, got[0].rendered);
+}
+
+TEST(CpuRenderer, RimCountsAreTheRenderedPixelsInTheRim) {
+  const ArticulatedModel model(hydrogel_geometry());
+  const Projection full = camera();
+  const Projection p = gtrack::scaled_projection(full, kScale);
+  auto r = cpu(model, full, kScale, 2);
+
+  Eigen::VectorXd nominal(12);
+  nominal << 0.2, -0.1, 45, 10, -15, 20, 30, 30, 30, 30, 30, 30;
+  const cv::Mat obs = reference_mask(model, p, nominal);
+  // The rim: a two-pixel ring around O, plus speckle elsewhere outside O
+  // (the renderer counts whatever it is given, with any non-zero value).
+  cv::Mat rim;
+  cv::dilate(obs, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  std::mt19937 rng(5);
+  for (int k = 0; k < 500; ++k) rim.at<std::uint8_t>(rng() % 256, rng() % 256) = 7;
+  rim.setTo(0, obs);
+  r->set_observation(obs);
+  r->set_rim(rim);
+
+  Eigen::MatrixXd H = random_hypotheses(120, 9, model.fingers());
+  H.col(0) = nominal;
+  std::vector<PairCounts> got;
+  r->evaluate(H, got);
+  int touching = 0;
+  for (int i = 0; i < H.cols(); ++i) {
+    const cv::Mat ref = reference_mask(model, p, H.col(i));
+    cv::Mat both, near;
+    cv::bitwise_and(ref, obs, both);
+    cv::bitwise_and(ref, rim, near);
+    EXPECT_EQ(got[i].rendered, static_cast<std::uint32_t>(count(ref))) << "hypothesis " << i;
+    EXPECT_EQ(got[i].intersection, static_cast<std::uint32_t>(count(both))) << "hypothesis " << i;
+    EXPECT_EQ(got[i].rim, static_cast<std::uint32_t>(count(near))) << "hypothesis " << i;
+    touching += got[i].rim > 0;
+  }
+  EXPECT_EQ(got[0].rim, 0u);  // the pose of O itself stays inside it
+  EXPECT_GT(touching, 10);
+  // A new observation clears the rim, and so does an empty one.
+  r->set_observation(obs);
+  r->evaluate(H, got);
+  for (const PairCounts& c : got) EXPECT_EQ(c.rim, 0u);
+  r->set_rim(rim);
+  r->set_rim(cv::Mat());
+  r->evaluate(H, got);
+  for (const PairCounts& c : got) EXPECT_EQ(c.rim, 0u);
+  EXPECT_THROW(r->set_rim(cv::Mat(255, 256, CV_8UC1, cv::Scalar(0))), gtrack::Error);
 }
 
 TEST(CpuRenderer, FoldedFingersOverThePalmAreCountedOnce) {

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <random>
 #include <string>
@@ -276,6 +277,43 @@ TEST(GlRenderer, AgreesWithCpuAndOracleOnAnUltrasoundSlab) {
   const Eigen::MatrixXd H = slab_hypotheses(400, 5, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(12));
   expect_agreement(*gl, s, H, 1);
+}
+
+TEST(GlRenderer, RimCountsAgreeWithCpu) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(300, 17, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(3));
+  cv::Mat rim;
+  cv::dilate(s.observation, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  rim.setTo(0, s.observation);
+  auto cpu = make_cpu();
+  for (Renderer* r : {gl.get(), cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+    r->set_rim(rim);
+  }
+  std::vector<PairCounts> from_gl, from_cpu;
+  gl->evaluate(H, from_gl);
+  cpu->evaluate(H, from_cpu);
+  ASSERT_EQ(from_gl.size(), from_cpu.size());
+  int touching = 0;
+  for (size_t i = 0; i < from_gl.size(); ++i) {
+    EXPECT_TRUE(counts_agree(from_gl[i].rim, from_cpu[i].rim)) << "hypothesis " << i;
+    EXPECT_TRUE(counts_agree(from_gl[i].intersection, from_cpu[i].intersection)) << "hypothesis " << i;
+    EXPECT_TRUE(counts_agree(from_gl[i].rendered, from_cpu[i].rendered)) << "hypothesis " << i;
+    touching += from_cpu[i].rim > 0;
+  }
+  EXPECT_GT(touching, 30);
+  // A new observation clears the rim; the observed pixels are unchanged.
+  gl->set_observation(s.observation);
+  gl->evaluate(H, from_gl);
+  for (size_t i = 0; i < from_gl.size(); ++i) {
+    EXPECT_EQ(from_gl[i].rim, 0u) << "hypothesis " << i;
+    EXPECT_TRUE(counts_agree(from_gl[i].intersection, from_cpu[i].intersection)) << "hypothesis " << i;
+  }
+  EXPECT_THROW(gl->set_rim(cv::Mat::zeros(8, 8, CV_8UC1)), gtrack::Error);
 }
 
 TEST(GlRenderer, TheSlabKeepsOnlyWhatIsInsideIt) {

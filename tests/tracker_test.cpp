@@ -466,6 +466,33 @@ TEST(Tracker, ScoreRepeatsTheFramesCost) {
   EXPECT_THROW(tracker.score(e.hypothesis.head(8)), gtrack::Error);
 }
 
+// [cost] occlusion_rim_px: under an occluder, a model larger than the truth
+// that covers what is visible spills within the budget's allowance; only the
+// rim, the ring just outside O, tells it from the truth.
+TEST(Tracker, TheRimMakesALooseModelPayUnderAnOccluder) {
+  auto setup = make_setup();
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  Eigen::VectorXd loose = truth;
+  loose[2] -= 4;  // 4 % nearer the camera: the same outline, 8 % more area
+  double gap[2] = {0, 0};
+  for (int rim : {0, 1}) {
+    auto config = gtrack::engine_config(setup);
+    config.cost.occlusion_rim_px = rim;
+    gtrack::Tracker tracker(setup, config);
+    tracker.set_estimate(truth);
+    tracker.process(scene(setup, truth, 1), 0, 0.0, 26.0);
+    tracker.process(scene(setup, truth, 2), 1, 1 / 30.0, 26.0);
+    const auto e = tracker.process(half_covered(tracker, setup, truth, 3), 2, 2 / 30.0, 26.0);
+    ASSERT_GT(e.outside_allowance, 0.0);
+    gap[rim] = tracker.score(loose).dice - tracker.score(truth).dice;
+  }
+  // The budget alone: nearly as good as the truth (0.005 here). With the rim
+  // the gap doubles (0.011): the loose model's spill along the visible
+  // outline is no longer taken as hidden.
+  EXPECT_LT(gap[0], 0.008);
+  EXPECT_GT(gap[1], gap[0] + 0.004);
+}
+
 // [tracker] redetect_dice: a track that sits on a wrong configuration while
 // the gripper is in plain view is replaced by the coarse search's result.
 TEST(Tracker, RedetectionReplacesAWrongTrack) {
@@ -558,6 +585,7 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_tolerance, 0.05);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_growth_weight, 0.1);
+  EXPECT_EQ(c.cost.occlusion_rim_px, 1);
   EXPECT_DOUBLE_EQ(c.tracker.redetect_dice, 0.01);
   EXPECT_TRUE(c.tracker.mirror_check);
   EXPECT_TRUE(c.tracker.coarse_wide_tilts);
@@ -584,6 +612,22 @@ TEST(EngineConfig, UnknownTableIsAnError) {
   auto setup = make_setup("[tracer]\nfps = 10\n");
   gtrack::engine_config(setup);
   EXPECT_THROW(gtrack::check_root_keys(setup), gtrack::ConfigError);
+}
+
+TEST(EngineConfig, TheRimIsAWholeNumberOfPixels) {
+  EXPECT_EQ(gtrack::engine_config(make_setup("[cost]\nocclusion_rim_px = 0\n")).cost.occlusion_rim_px, 0);
+  EXPECT_EQ(gtrack::engine_config(make_setup("[cost]\nocclusion_rim_px = 3\n")).cost.occlusion_rim_px, 3);
+  for (const char* bad : {"1.5", "-1", "17", "\"one\""}) {
+    auto setup = make_setup(std::string("[cost]\nocclusion_rim_px = ") + bad + "\n");
+    try {
+      gtrack::engine_config(setup);
+      ADD_FAILURE() << bad << ": expected ConfigError";
+    } catch (const gtrack::ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("occlusion_rim_px"), std::string::npos) << m;
+      EXPECT_NE(m.find("<test>:"), std::string::npos) << m;
+    }
+  }
 }
 
 TEST(EngineConfig, InitialPoseMustHaveEveryParameter) {

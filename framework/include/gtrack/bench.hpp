@@ -28,6 +28,7 @@ struct BenchScene {
   double scale = 0.25;    // render size = scale * image size
   Eigen::VectorXd nominal;
   cv::Mat observation;   // CV_8U at render size: the gripper at `nominal`
+  cv::Mat rim;           // the one-pixel ring just outside it, counted as the tracker's rim
   double gripper_px = 0;  // tip-to-tip extent of the open gripper at render size
 };
 

@@ -51,9 +51,16 @@ GTRACK_API double dice_distance(std::uint64_t intersection, std::uint64_t observ
 // the true configuration of a partly hidden gripper scores about 0, as it
 // would unoccluded, so shrinking or folding the hidden part away no longer
 // pays, while a hypothesis that grows beyond the expected area still does.
+//
+// rim: how many of the P\O pixels lie in the rim, just outside O. They are
+// never taken as hidden: the allowance and its tolerance apply to the other
+// P\O pixels only. An occluder hides a part that continues the gripper, so
+// the true configuration crosses the rim only along the occluder's edge,
+// while a model placed loosely around the visible part spills along its
+// whole outline.
 GTRACK_API double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
                                          double outside_weight, double allowance = 0, double tolerance = 0,
-                                         double tolerance_weight = 0);
+                                         double tolerance_weight = 0, std::uint64_t rim = 0);
 
 // The temporal term T: mean over parameters of ((h_d - p_d) / sigma_d)^2, p
 // the prediction; rz (index 5) differences are taken the short way when
@@ -93,6 +100,9 @@ class GTRACK_API CostEvaluator {
     outside_tolerance_ = tolerance > 0 ? tolerance : 0;
   }
   double outside_allowance() const { return outside_allowance_; }
+  // Whether the renderers' rim counts (PairCounts::rim) are used: the rim's
+  // P\O pixels are never taken as hidden (see weighted_dice_distance).
+  void set_use_rim(bool use) { use_rim_ = use; }
   const CostWeights& weights() const { return weights_; }
   std::uint64_t evaluations() const { return evaluations_; }
 
@@ -109,6 +119,7 @@ class GTRACK_API CostEvaluator {
   double outside_weight_ = 1.0;
   double outside_allowance_ = 0;
   double outside_tolerance_ = 0;
+  bool use_rim_ = false;
 };
 
 }  // namespace gtrack

@@ -86,6 +86,13 @@ struct CostWeights {
   // the next frame's allowance, taken from that larger model, lets it grow
   // again, so under a long occlusion the model ratchets up.
   double occlusion_growth_weight = 0.1;
+  // occlusion_rim_px >= 0: rendered pixels outside O but within this many
+  // render pixels of it (the rim) are never taken as hidden. An occluder
+  // hides a part that continues the gripper, so the true configuration's
+  // spill crosses the rim only along the occluder's edge; a model placed
+  // loosely around the visible part spills along the whole outline and
+  // pays for it. 0 = the budget alone.
+  int occlusion_rim_px = 1;
 };
 
 struct SearchConfig {

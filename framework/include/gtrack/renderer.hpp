@@ -5,7 +5,8 @@
 // observation mask at render size. For a batch of hypotheses (one per column,
 // see parameter_space.hpp) it returns, per hypothesis,
 //   intersection = |O & P|  and  rendered = |P|,
-// from which |O | P| = |O| + |P| - |O & P|. Both backends fill triangles with
+// from which |O | P| = |O| + |P| - |O & P|, and rim = |R & P| for a second
+// mask R (set_rim; the cost's occlusion rim, pixels just outside O). Both backends fill triangles with
 // the pixel-centre rule (pixel (i, j) is covered when (i + 0.5, j + 0.5) is
 // inside, top-left rule on edges), after clipping against the projection's
 // clip planes; a mask is the union of the triangles, never a sum.
@@ -31,6 +32,7 @@ namespace gtrack {
 struct PairCounts {
   std::uint32_t intersection = 0;  // |O & P|
   std::uint32_t rendered = 0;      // |P|
+  std::uint32_t rim = 0;           // |R & P| (0 while no rim is set)
 };
 
 struct RenderOptions {
@@ -50,6 +52,10 @@ class GTRACK_API Renderer {
   virtual ImageSize render_size() const = 0;
   // CV_8U at render_size(); non-zero pixels belong to the observation.
   virtual void set_observation(const cv::Mat& mask) = 0;
+  // CV_8U at render_size(); non-zero pixels are counted in PairCounts::rim.
+  // An empty Mat clears the rim; set_observation() clears it too. The rim is
+  // meant to lie outside O, but nothing requires it.
+  virtual void set_rim(const cv::Mat& rim) = 0;
   // |O| of the current observation.
   virtual std::uint64_t observation_count() const = 0;
 

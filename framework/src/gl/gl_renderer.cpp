@@ -22,7 +22,7 @@ namespace {
 constexpr int kLayerBits = 32;         // hypotheses per R32UI layer
 constexpr int kCountGroupWidth = 32;   // columns per count workgroup
 constexpr int kMaxCountRows = 255;     // rows per count invocation: the most count.comp allows
-static_assert(kCountGroupWidth >= 32, "count.comp clears and sums 32 shared counters with one invocation each");
+constexpr int kCountsPerHypothesis = 3;  // |O & P|, |P|, |R & P|, as count.comp writes them
 static_assert(kMaxCountRows * kCountGroupWidth <= 0xFFFF, "a workgroup's counts must fit the 16-bit halves");
 
 // Rows per count invocation. A CPU driver (llvmpipe) runs few threads and
@@ -267,6 +267,7 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
     gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
     gl_.BindTextureUnit(1, observation_);
     observation_count_ = 0;
+    observation_bits_.release();
   }
   gl_.check("setting the projection");
 }
@@ -279,11 +280,37 @@ void GlRenderer::set_observation(const cv::Mat& mask) {
                 std::to_string(s.height) + ", got " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
                 " of type " + std::to_string(mask.type()));
   }
+  // Bit 0 of the texture is O, bit 1 the rim (cleared here).
+  cv::compare(mask, 0, observation_bits_, cv::CMP_NE);
+  observation_bits_ &= 1;
+  observation_count_ = static_cast<std::uint64_t>(cv::countNonZero(observation_bits_));
+  upload_observation(observation_bits_);
+}
+
+void GlRenderer::set_rim(const cv::Mat& rim) {
+  if (!has_projection_) throw Error("gl backend: set_rim() before set_projection()");
+  const ImageSize s = projection_.size;
+  if (rim.empty()) {
+    if (!observation_bits_.empty()) upload_observation(observation_bits_);
+    return;
+  }
+  if (rim.type() != CV_8UC1 || rim.cols != s.width || rim.rows != s.height) {
+    throw Error("gl backend: the rim must be CV_8U at the render size " + std::to_string(s.width) + "x" +
+                std::to_string(s.height) + ", got " + std::to_string(rim.cols) + "x" + std::to_string(rim.rows) +
+                " of type " + std::to_string(rim.type()));
+  }
+  cv::Mat bits;
+  cv::compare(rim, 0, bits, cv::CMP_NE);
+  bits &= 2;
+  if (!observation_bits_.empty()) bits |= observation_bits_;
+  upload_observation(bits);
+}
+
+void GlRenderer::upload_observation(const cv::Mat& bits) {
+  const ImageSize s = projection_.size;
   context_.make_current();
   wait_for_fence();
-  const cv::Mat packed = mask.isContinuous() ? mask : mask.clone();
-  gl_.TextureSubImage2D(observation_, 0, 0, 0, s.width, s.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE, packed.data);
-  observation_count_ = static_cast<std::uint64_t>(cv::countNonZero(packed));
+  gl_.TextureSubImage2D(observation_, 0, 0, 0, s.width, s.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE, bits.data);
   gl_.check("uploading the observation");
 }
 
@@ -306,9 +333,9 @@ void GlRenderer::reserve_hypotheses(int count) {
   for (GLuint* b : {&hypothesis_buffer_, &count_buffer_, &readback_buffer_}) delete_buffer(gl_, *b);
   hypothesis_buffer_ =
       make_buffer(gl_, GLsizeiptr(capacity) * dims_ * GLsizeiptr(sizeof(float)), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  // The atomics hit a buffer the GPU owns; only the final 8 N bytes are
+  // The atomics hit a buffer the GPU owns; only the final 12 N bytes are
   // copied into host-visible memory, mapped once for good.
-  const GLsizeiptr count_bytes = GLsizeiptr(capacity) * 2 * GLsizeiptr(sizeof(std::uint32_t));
+  const GLsizeiptr count_bytes = GLsizeiptr(capacity) * kCountsPerHypothesis * GLsizeiptr(sizeof(std::uint32_t));
   count_buffer_ = make_buffer(gl_, count_bytes, nullptr, 0);
   const GLbitfield map = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
   readback_buffer_ = make_buffer(gl_, count_bytes, nullptr, map | GL_CLIENT_STORAGE_BIT);
@@ -394,7 +421,7 @@ void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
   }
   gl_.NamedBufferSubData(box_buffer_, 0, GLsizeiptr(boxes_.size() * sizeof(PixelBox)), boxes_.data());
 
-  const GLsizeiptr count_bytes = GLsizeiptr(n) * 2 * GLsizeiptr(sizeof(std::uint32_t));
+  const GLsizeiptr count_bytes = GLsizeiptr(n) * kCountsPerHypothesis * GLsizeiptr(sizeof(std::uint32_t));
   gl_.ClearNamedBufferSubData(count_buffer_, GL_R32UI, 0, count_bytes, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   draw(n);
   if (max_w > 0 && max_h > 0) {
@@ -441,7 +468,8 @@ void GlRenderer::finish(std::vector<PairCounts>& out) {
   pending_ = -1;
   out.resize(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
-    out[static_cast<size_t>(i)] = PairCounts{readback_[2 * i], readback_[2 * i + 1]};
+    const std::uint32_t* c = readback_ + kCountsPerHypothesis * i;
+    out[static_cast<size_t>(i)] = PairCounts{c[0], c[1], c[2]};
   }
 }
 

@@ -33,6 +33,7 @@ class GlRenderer final : public Renderer {
   void set_projection(const Projection& projection, double scale) override;
   ImageSize render_size() const override { return projection_.size; }
   void set_observation(const cv::Mat& mask) override;
+  void set_rim(const cv::Mat& rim) override;
   std::uint64_t observation_count() const override { return observation_count_; }
 
   void submit(const Eigen::MatrixXd& hypotheses) override;
@@ -48,6 +49,7 @@ class GlRenderer final : public Renderer {
   // Clears the target and draws hypotheses 0 .. count-1 into it.
   void draw(int count);
   void wait_for_fence();
+  void upload_observation(const cv::Mat& bits);
   void release() noexcept;
 
   EglContext context_;
@@ -59,7 +61,8 @@ class GlRenderer final : public Renderer {
   GLuint vao_ = 0;
   GLuint framebuffer_ = 0;
   GLuint target_ = 0;       // R32UI 2D array, one layer per 32 hypotheses
-  GLuint observation_ = 0;  // R8UI
+  GLuint observation_ = 0;  // R8UI: bit 0 O, bit 1 the rim
+  cv::Mat observation_bits_;  // O as uploaded (0 / 1), to combine with a rim
   GLuint mesh_buffer_ = 0, finger_buffer_ = 0, link_buffer_ = 0;
   GLuint hypothesis_buffer_ = 0, box_buffer_ = 0, count_buffer_ = 0, readback_buffer_ = 0;
   const std::uint32_t* readback_ = nullptr;  // persistent, coherent mapping of readback_buffer_

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "gtrack/config.hpp"
@@ -63,6 +64,8 @@ BenchScene make_bench_scene(const ArticulatedModel& model, int render_side, doub
   r->set_model(model);
   r->set_projection(s.projection, s.scale);
   s.observation = r->render_mask(s.nominal);
+  cv::dilate(s.observation, s.rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  s.rim.setTo(0, s.observation);
   return s;
 }
 
@@ -92,6 +95,7 @@ void prepare(Renderer& renderer, const BenchScene& scene) {
   renderer.set_model(scene.model);
   renderer.set_projection(scene.projection, scene.scale);
   renderer.set_observation(scene.observation);
+  renderer.set_rim(scene.rim);
 }
 
 double since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }

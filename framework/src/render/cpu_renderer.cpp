@@ -72,6 +72,8 @@ class CpuRenderer final : public Renderer {
     const ImageSize s = projection_.size;
     observation_.resize(s.width, s.height);
     observation_count_ = 0;
+    rim_.resize(s.width, s.height);
+    has_rim_ = false;
     for (int w = 0; w < pool_.size(); ++w) {
       scratch_[w].mask.resize(s.width, s.height);
       scratch_[w].model_projection.clip_planes.reserve(projection_.clip_planes.size());
@@ -91,6 +93,21 @@ class CpuRenderer final : public Renderer {
     }
     observation_.pack(mask);
     observation_count_ = observation_.count();
+    has_rim_ = false;
+  }
+
+  void set_rim(const cv::Mat& rim) override {
+    require_projection();
+    has_rim_ = false;
+    if (rim.empty()) return;
+    const ImageSize s = projection_.size;
+    if (rim.type() != CV_8UC1 || rim.cols != s.width || rim.rows != s.height) {
+      throw Error("cpu renderer: the rim must be CV_8U " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                  " (the render size), got " + std::to_string(rim.cols) + "x" + std::to_string(rim.rows) +
+                  " of type " + std::to_string(rim.type()));
+    }
+    rim_.pack(rim);
+    has_rim_ = true;
   }
 
   std::uint64_t observation_count() const override { return observation_count_; }
@@ -103,7 +120,8 @@ class CpuRenderer final : public Renderer {
       Scratch& s = scratch_[worker];
       Box box;
       fill(hypotheses.col(i).data(), s, box);
-      results_[i] = render::count_and_clear(s.mask, observation_, box);
+      results_[i] = has_rim_ ? render::count_and_clear(s.mask, observation_, rim_, box)
+                             : render::count_and_clear(s.mask, observation_, box);
     };
     pool_.run(n, job);
   }
@@ -160,6 +178,8 @@ class CpuRenderer final : public Renderer {
   bool has_projection_ = false;
   BitMask observation_;
   std::uint64_t observation_count_ = 0;
+  BitMask rim_;
+  bool has_rim_ = false;
   std::vector<PairCounts> results_;
 };
 

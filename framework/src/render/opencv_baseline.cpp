@@ -37,6 +37,19 @@ void OpenCvBaseline::set_observation(const cv::Mat& mask) {
   }
   cv::compare(mask, 0, observation_, cv::CMP_NE);
   observation_count_ = static_cast<std::uint64_t>(cv::countNonZero(observation_));
+  rim_.release();
+}
+
+void OpenCvBaseline::set_rim(const cv::Mat& rim) {
+  if (!has_projection_) throw Error("opencv baseline: set_projection() must come before set_rim()");
+  rim_.release();
+  if (rim.empty()) return;
+  const ImageSize s = projection_.size;
+  if (rim.type() != CV_8UC1 || rim.cols != s.width || rim.rows != s.height) {
+    throw Error("opencv baseline: the rim must be CV_8U at the render size " + std::to_string(s.width) + "x" +
+                std::to_string(s.height));
+  }
+  cv::compare(rim, 0, rim_, cv::CMP_NE);
 }
 
 void OpenCvBaseline::fill(const Eigen::Ref<const Eigen::VectorXd>& h, Scratch& s) const {
@@ -74,6 +87,11 @@ void OpenCvBaseline::submit(const Eigen::MatrixXd& hypotheses) {
     const int either = cv::countNonZero(s.combined);
     results_[i].intersection = static_cast<std::uint32_t>(both);
     results_[i].rendered = static_cast<std::uint32_t>(either + both - static_cast<int>(observation_count_));
+    results_[i].rim = 0;
+    if (!rim_.empty()) {
+      cv::bitwise_and(s.mask, rim_, s.combined);
+      results_[i].rim = static_cast<std::uint32_t>(cv::countNonZero(s.combined));
+    }
   };
   pool_.run(n, job);
 }

@@ -25,6 +25,7 @@ class OpenCvBaseline final : public Renderer {
   void set_projection(const Projection& projection, double scale) override;
   ImageSize render_size() const override { return projection_.size; }
   void set_observation(const cv::Mat& mask) override;
+  void set_rim(const cv::Mat& rim) override;
   std::uint64_t observation_count() const override { return observation_count_; }
   void submit(const Eigen::MatrixXd& hypotheses) override;
   void finish(std::vector<PairCounts>& out) override { out.assign(results_.begin(), results_.end()); }
@@ -45,7 +46,7 @@ class OpenCvBaseline final : public Renderer {
   std::unique_ptr<ArticulatedModel> model_;
   Projection projection_;
   bool has_projection_ = false;
-  cv::Mat observation_;
+  cv::Mat observation_, rim_;  // rim_ empty: none
   std::uint64_t observation_count_ = 0;
   std::vector<PairCounts> results_;
 };

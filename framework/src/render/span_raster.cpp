@@ -281,4 +281,26 @@ PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const 
   return c;
 }
 
+PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const BitMask& rim, const Box& box) {
+  PairCounts c;
+  if (box.empty()) return c;
+  std::uint32_t both = 0, mine = 0, near = 0;
+  for (int y = box.y0; y <= box.y1; ++y) {
+    std::uint64_t* p = rendered.row(y);
+    const std::uint64_t* o = observation.row(y);
+    const std::uint64_t* r = rim.row(y);
+    for (int w = box.w0; w <= box.w1; ++w) {
+      const std::uint64_t bits = p[w];
+      mine += static_cast<std::uint32_t>(std::popcount(bits));
+      both += static_cast<std::uint32_t>(std::popcount(bits & o[w]));
+      near += static_cast<std::uint32_t>(std::popcount(bits & r[w]));
+      p[w] = 0;
+    }
+  }
+  c.intersection = both;
+  c.rendered = mine;
+  c.rim = near;
+  return c;
+}
+
 }  // namespace gtrack::render

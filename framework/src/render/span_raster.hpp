@@ -44,5 +44,7 @@ void fill_projected(const Eigen::Vector3d* corners, int n, BitMask& mask, Box& b
 // Counts |O & P| and |P| over `box` and clears P there, so that the mask is
 // all zero again for the next hypothesis.
 PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const Box& box);
+// The same, with |R & P| counted against `rim` too.
+PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const BitMask& rim, const Box& box);
 
 }  // namespace gtrack::render

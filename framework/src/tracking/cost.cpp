@@ -17,7 +17,8 @@ double dice_distance(std::uint64_t intersection, std::uint64_t observed, std::ui
 }
 
 double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed, std::uint64_t rendered,
-                              double outside_weight, double allowance, double tolerance, double tolerance_weight) {
+                              double outside_weight, double allowance, double tolerance, double tolerance_weight,
+                              std::uint64_t rim) {
   if (intersection > rendered) intersection = rendered;
   const double w = outside_weight < 0 ? 0.0 : (outside_weight > 1 ? 1.0 : outside_weight);
   const double i = static_cast<double>(intersection);
@@ -26,9 +27,12 @@ double weighted_dice_distance(std::uint64_t intersection, std::uint64_t observed
   // tolerance counts with its own weight.
   double outside = static_cast<double>(rendered - intersection);
   if (allowance > 0) {
+    // The rim's pixels are never hidden; the allowance covers the rest.
+    const double near = std::min(outside, static_cast<double>(rim));
+    const double rest = outside - near;
     const double t = std::max(0.0, tolerance);
-    const double slack = std::clamp(outside - allowance, 0.0, t);
-    outside = std::max(0.0, outside - allowance - t) + std::clamp(tolerance_weight, 0.0, 1.0) * slack;
+    const double slack = std::clamp(rest - allowance, 0.0, t);
+    outside = near + std::max(0.0, rest - allowance - t) + std::clamp(tolerance_weight, 0.0, 1.0) * slack;
   }
   const double denom = static_cast<double>(observed) + i + w * outside;  // 2|O&P| + |O\P| + w|P\O|
   if (denom <= 0) return rendered == 0 ? 0.0 : 1.0;
@@ -84,7 +88,8 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
       out[i].rendered += counts_[i].rendered;
       out[i].overlap += std::min(counts_[i].intersection, counts_[i].rendered);
       out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_,
-                                            outside_allowance_, outside_tolerance_, weights_.occlusion_growth_weight);
+                                            outside_allowance_, outside_tolerance_, weights_.occlusion_growth_weight,
+                                            use_rim_ ? counts_[i].rim : 0);
     }
   }
   const double views = static_cast<double>(renderers_.size());

@@ -67,6 +67,8 @@ CostWeights read_cost(const ConfigTable& t) {
   c.occlusion_tolerance = t.number_or("occlusion_tolerance", c.occlusion_tolerance, Range::closed(0.0, 1.0));
   c.occlusion_growth_weight =
       t.number_or("occlusion_growth_weight", c.occlusion_growth_weight, Range::closed(0.0, 1.0));
+  c.occlusion_rim_px =
+      static_cast<int>(t.integer_or("occlusion_rim_px", c.occlusion_rim_px, Range::closed(0, 16)));
   return c;
 }
 

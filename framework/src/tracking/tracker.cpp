@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <opencv2/imgproc.hpp>
+
 #include "coarse_search.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
@@ -72,6 +74,20 @@ struct Tracker::Impl {
     segmenter = std::make_unique<Segmenter>(config.observation, setup.sensor->image_size(), renderer->render_size());
     cost = std::make_unique<CostEvaluator>(std::vector<Renderer*>{renderer.get()}, *setup.gripper, nullptr,
                                            config.cost);
+    cost->set_use_rim(config.cost.occlusion_rim_px > 0);
+  }
+
+  // Hands the current observation to the renderer, with its rim: the pixels
+  // within occlusion_rim_px of O, outside it, which the occlusion budget
+  // never takes as hidden.
+  void show_observation() {
+    renderer->set_observation(observation.mask);
+    const int k = config.cost.occlusion_rim_px;
+    if (k <= 0) return;
+    cv::Mat grown;
+    cv::dilate(observation.mask, grown, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * k + 1, 2 * k + 1)));
+    grown.setTo(0, observation.mask);
+    renderer->set_rim(grown);
   }
 
   Eigen::VectorXd spread() const {
@@ -184,10 +200,10 @@ struct Tracker::Impl {
       before_last.reset();
       e.status = TrackStatus::Lost;
       e.hypothesis = last ? *last : fallback_pose();
-      renderer->set_observation(observation.mask);
+      show_observation();
       e.terms = cost->evaluate_one(e.hypothesis);
     } else {
-      renderer->set_observation(observation.mask);
+      show_observation();
       const std::uint64_t evals0 = cost->evaluations();
       // Single scores of a result (not the search's evaluations): `terms` is
       // always the score of `best` on the current observation.
@@ -227,7 +243,7 @@ struct Tracker::Impl {
           CostTerms current = tracked;
           if (widened) {
             observation = whole;
-            renderer->set_observation(observation.mask);
+            show_observation();
             set_allowance(previous_area);
             visible = visible_share(previous_area);
             current = score(best);
@@ -260,7 +276,7 @@ struct Tracker::Impl {
             e.redetected = true;
           } else if (widened) {
             observation = trimmed;
-            renderer->set_observation(observation.mask);
+            show_observation();
             set_allowance(previous_area);
           }
         }
