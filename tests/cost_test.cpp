@@ -242,6 +242,11 @@ TEST(Cost, EvaluatorUsesTheRimCountsOnlyWhenAsked) {
   EXPECT_DOUBLE_EQ(t[0].dice, 1.0 - 100.0 / 105.0);
   EXPECT_DOUBLE_EQ(t[1].dice, 1.0 - 100.0 / 130.0);
   EXPECT_LT(t[0].total, t[1].total);
+  // The rim pixels are reported, and D without them is the budget's alone.
+  EXPECT_EQ(t[0].rim, 5u);
+  EXPECT_EQ(t[1].rim, 30u);
+  EXPECT_DOUBLE_EQ(t[0].dice_without_rim, 0.0);
+  EXPECT_DOUBLE_EQ(t[1].dice_without_rim, 0.0);
 }
 
 TEST(Cost, TemporalTermIsMahalanobisToThePrediction) {

@@ -459,6 +459,8 @@ TEST(Tracker, ScoreRepeatsTheFramesCost) {
   EXPECT_DOUBLE_EQ(again.temporal, e.terms.temporal);
   EXPECT_EQ(again.rendered, e.terms.rendered);
   EXPECT_EQ(again.overlap, e.terms.overlap);
+  EXPECT_EQ(again.rim, e.terms.rim);
+  EXPECT_GT(again.rim, 0u);                  // along the occluder's edge
   EXPECT_GT(again.rendered, again.overlap);  // half of it is hidden
   Eigen::VectorXd off = e.hypothesis;
   off[0] += 0.3;

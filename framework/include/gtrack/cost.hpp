@@ -31,6 +31,11 @@ struct CostTerms {
   // hypothesis shows where nothing was observed, is rendered - overlap.
   std::uint64_t rendered = 0;
   std::uint64_t overlap = 0;
+  // Rendered pixels in the occlusion rim (0 when the rim is not used).
+  std::uint64_t rim = 0;
+  // D as the occlusion budget alone would score it (the rim's pixels taken
+  // as hidden like the others): equal to `dice` without an allowance.
+  double dice_without_rim = 1;
 };
 
 // D from counts. An empty observation and an empty hypothesis agree

@@ -65,7 +65,7 @@ CostEvaluator::CostEvaluator(std::vector<Renderer*> renderers, const Gripper& gr
 void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<CostTerms>& out) {
   const int n = static_cast<int>(hypotheses.cols());
   out.assign(n, CostTerms{});
-  for (auto& t : out) t.dice = 0;
+  for (auto& t : out) t.dice = t.dice_without_rim = 0;
   // Every renderer starts its batch first; K and S are computed while they work.
   for (Renderer* r : renderers_) r->submit(hypotheses);
   for (int i = 0; i < n; ++i) {
@@ -87,14 +87,22 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     for (int i = 0; i < n; ++i) {
       out[i].rendered += counts_[i].rendered;
       out[i].overlap += std::min(counts_[i].intersection, counts_[i].rendered);
-      out[i].dice += weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_,
-                                            outside_allowance_, outside_tolerance_, weights_.occlusion_growth_weight,
-                                            use_rim_ ? counts_[i].rim : 0);
+      const std::uint64_t rim = use_rim_ ? counts_[i].rim : 0;
+      out[i].rim += rim;
+      const double budget_only =
+          weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered, outside_weight_,
+                                 outside_allowance_, outside_tolerance_, weights_.occlusion_growth_weight);
+      out[i].dice_without_rim += budget_only;
+      out[i].dice += rim == 0 ? budget_only
+                              : weighted_dice_distance(counts_[i].intersection, observed, counts_[i].rendered,
+                                                       outside_weight_, outside_allowance_, outside_tolerance_,
+                                                       weights_.occlusion_growth_weight, rim);
     }
   }
   const double views = static_cast<double>(renderers_.size());
   for (auto& t : out) {
     t.dice /= views;
+    t.dice_without_rim /= views;
     t.total = weights_.dice * t.dice + weights_.kinematic * t.kinematic + weights_.stimulus * t.stimulus +
               weights_.temporal * t.temporal;
   }

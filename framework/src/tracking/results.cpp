@@ -105,7 +105,8 @@ std::string estimate_json(const Estimate& e) {
        ",\"outside_weight\":" + num(e.outside_weight, "%.4f") +
        ",\"outside_allowance\":" + num(e.outside_allowance, "%.1f") +
        ",\"rendered_pixels\":" + std::to_string(e.terms.rendered) +
-       ",\"overlap_pixels\":" + std::to_string(e.terms.overlap) + ",\"redetected\":" +
+       ",\"overlap_pixels\":" + std::to_string(e.terms.overlap) + ",\"rim_pixels\":" + std::to_string(e.terms.rim) +
+       ",\"redetected\":" +
        (e.redetected ? "true" : "false") + ",\"mirrored\":" + (e.mirrored ? "true" : "false");
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
@@ -114,7 +115,7 @@ std::string estimate_json(const Estimate& e) {
     j += ",\"reference\":{\"cost\":" + num(r->total, "%.6f") + ",\"D\":" + num(r->dice, "%.6f") +
          ",\"K\":" + num(r->kinematic, "%.6f") + ",\"S\":" + num(r->stimulus, "%.6f") +
          ",\"T\":" + num(r->temporal, "%.6f") + ",\"rendered_pixels\":" + std::to_string(r->rendered) +
-         ",\"overlap_pixels\":" + std::to_string(r->overlap) + "}";
+         ",\"overlap_pixels\":" + std::to_string(r->overlap) + ",\"rim_pixels\":" + std::to_string(r->rim) + "}";
   }
   j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") + "}";
   return j;

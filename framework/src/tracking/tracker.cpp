@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
 
@@ -228,7 +229,10 @@ struct Tracker::Impl {
         e.status = TrackStatus::Tracked;
         const CostTerms tracked = score(best);
         terms = tracked;
-        if (tracked.dice > config.tracker.redetect_dice) {
+        // The fit is judged without the rim: the true configuration of a
+        // partly hidden gripper pays for the rim along the occluder's edge,
+        // which says nothing about whether the track is wrong.
+        if (tracked.dice_without_rim > config.tracker.redetect_dice) {
           // Re-detection: the coarse search, and a swarm around the track
           // with three times the spreads (the right configuration is often a
           // nearby basin the coarse grid's steps do not reach: strong tilts,
