@@ -60,7 +60,10 @@ std::map<int, FrameScores> frame_scores(const fs::path& estimates_csv) {
       const std::string ref = line.substr(ref_at, line.find('}', ref_at) - ref_at);
       s.reference_cost = field(ref, "cost");
       const auto rendered = field(ref, "rendered_pixels"), overlap = field(ref, "overlap_pixels");
-      if (rendered && overlap) s.reference_outside = *rendered - *overlap;
+      // The rim's pixels are never taken as hidden: only the rest of P\O
+      // is measured against the allowance.
+      const auto rim = field(ref, "rim_pixels");
+      if (rendered && overlap) s.reference_outside = *rendered - *overlap - rim.value_or(0.0);
     }
   }
   return out;
