@@ -173,15 +173,22 @@ TEST(CpuRenderer, MasksEqualTheReferenceWithTiesOnTheTopView) {
   }
 }
 
+// The hydrogel gripper at a nominal pose in front of the test camera.
+struct NominalScene {
+  ArticulatedModel model{hydrogel_geometry()};
+  Projection full = camera();
+  Projection p = gtrack::scaled_projection(full, kScale);
+  Eigen::VectorXd nominal = (Eigen::VectorXd(12) << 0.2, -0.1, 45, 10, -15, 20, 30, 30, 30, 30, 30, 30).finished();
+};
+
 TEST(CpuRenderer, CountsAreIntersectionAndRenderedOfTheMasks) {
-  const ArticulatedModel model(hydrogel_geometry());
-  const Projection full = camera();
-  const Projection p = gtrack::scaled_projection(full, kScale);
-  auto r = cpu(model, full, kScale, 2);
+  const NominalScene s;
+  const ArticulatedModel& model = s.model;
+  const Projection& p = s.p;
+  const Eigen::VectorXd& nominal = s.nominal;
+  auto r = cpu(model, s.full, kScale, 2);
 
   // Observation: the gripper at a nominal pose, plus speckle far from it.
-  Eigen::VectorXd nominal(12);
-  nominal << 0.2, -0.1, 45, 10, -15, 20, 30, 30, 30, 30, 30, 30;
   cv::Mat obs = reference_mask(model, p, nominal);
   std::mt19937 rng(11);
   for (int k = 0; k < 500; ++k) obs.at<std::uint8_t>(rng() % 256, rng() % 256) = 255;
@@ -205,14 +212,12 @@ TEST(CpuRenderer, CountsAreIntersectionAndRenderedOfTheMasks) {
 }
 
 TEST(CpuRenderer, RimCountsAreTheRenderedPixelsInTheRim) {
-  const ArticulatedModel model(hydrogel_geometry());
-  const Projection full = camera();
-  const Projection p = gtrack::scaled_projection(full, kScale);
-  auto r = cpu(model, full, kScale, 2);
+  const NominalScene s;
+  const ArticulatedModel& model = s.model;
+  const Projection& p = s.p;
+  auto r = cpu(model, s.full, kScale, 2);
 
-  Eigen::VectorXd nominal(12);
-  nominal << 0.2, -0.1, 45, 10, -15, 20, 30, 30, 30, 30, 30, 30;
-  const cv::Mat obs = reference_mask(model, p, nominal);
+  const cv::Mat obs = reference_mask(model, p, s.nominal);
   // The rim: a two-pixel ring around O, plus speckle elsewhere outside O
   // (the renderer counts whatever it is given, with any non-zero value).
   cv::Mat rim;
@@ -224,7 +229,7 @@ TEST(CpuRenderer, RimCountsAreTheRenderedPixelsInTheRim) {
   r->set_rim(rim);
 
   Eigen::MatrixXd H = random_hypotheses(120, 9, model.fingers());
-  H.col(0) = nominal;
+  H.col(0) = s.nominal;
   std::vector<PairCounts> got;
   r->evaluate(H, got);
   int touching = 0;
