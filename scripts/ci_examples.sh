@@ -56,9 +56,10 @@ run_setup() {  # run_setup NAME CONFIG FRAMES MAX_INPLANE_UM MAX_ORIENT_DEG MAX_
 run_setup examples examples/example_setup.toml 30 "${EXAMPLE_MAX_UM:-60}" "${EXAMPLE_MAX_DEG:-180}" "${EXAMPLE_MAX_JOINT_DEG:-15}"
 # The TOML-defined gripper is 2.9 mm across: a lost track is off by a
 # millimetre or more. On this one 60-frame sequence the swarm's seed alone
-# moves the in-plane error between about 30 and 210 um (docs/RESULTS.md, "How
-# much the swarm's own seed moves these numbers"), so the bound sits above
-# that spread.
+# moves the errors between 11.6 and 43.8 um, 3.2 and 13.3 deg, and up to 4.2
+# deg in the joints (docs/RESULTS.md, "How much the swarm's own seed moves
+# these numbers"), so the bounds sit above that spread; the tracker before
+# the occlusion rim (114 um, 21 deg) fails them.
 run_setup custom_gripper "$prefix/share/gtrack/configs/microscope_custom_gripper.toml" 60 \
-  "${CUSTOM_MAX_UM:-250}" "${CUSTOM_MAX_DEG:-30}" "${CUSTOM_MAX_JOINT_DEG:-10}"
+  "${CUSTOM_MAX_UM:-100}" "${CUSTOM_MAX_DEG:-20}" "${CUSTOM_MAX_JOINT_DEG:-6}"
 echo "ci_examples: passed"
