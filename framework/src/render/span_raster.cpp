@@ -262,38 +262,24 @@ void fill_polygons(const std::vector<ScreenPolygon>& polygons, BitMask& mask, Bo
   }
 }
 
-PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const Box& box) {
-  PairCounts c;
-  if (box.empty()) return c;
-  std::uint32_t both = 0, mine = 0;
-  for (int y = box.y0; y <= box.y1; ++y) {
-    std::uint64_t* p = rendered.row(y);
-    const std::uint64_t* o = observation.row(y);
-    for (int w = box.w0; w <= box.w1; ++w) {
-      const std::uint64_t bits = p[w];
-      mine += static_cast<std::uint32_t>(std::popcount(bits));
-      both += static_cast<std::uint32_t>(std::popcount(bits & o[w]));
-      p[w] = 0;
-    }
-  }
-  c.intersection = both;
-  c.rendered = mine;
-  return c;
-}
+namespace {
 
-PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const BitMask& rim, const Box& box) {
+// One pass over the box for both overloads; without a rim (null) the third
+// AND + popcount is compiled out.
+template <bool kWithRim>
+PairCounts count_and_clear_impl(BitMask& rendered, const BitMask& observation, const BitMask* rim, const Box& box) {
   PairCounts c;
   if (box.empty()) return c;
   std::uint32_t both = 0, mine = 0, near = 0;
   for (int y = box.y0; y <= box.y1; ++y) {
     std::uint64_t* p = rendered.row(y);
     const std::uint64_t* o = observation.row(y);
-    const std::uint64_t* r = rim.row(y);
+    const std::uint64_t* r = kWithRim ? rim->row(y) : nullptr;
     for (int w = box.w0; w <= box.w1; ++w) {
       const std::uint64_t bits = p[w];
       mine += static_cast<std::uint32_t>(std::popcount(bits));
       both += static_cast<std::uint32_t>(std::popcount(bits & o[w]));
-      near += static_cast<std::uint32_t>(std::popcount(bits & r[w]));
+      if constexpr (kWithRim) near += static_cast<std::uint32_t>(std::popcount(bits & r[w]));
       p[w] = 0;
     }
   }
@@ -301,6 +287,16 @@ PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const 
   c.rendered = mine;
   c.rim = near;
   return c;
+}
+
+}  // namespace
+
+PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const Box& box) {
+  return count_and_clear_impl<false>(rendered, observation, nullptr, box);
+}
+
+PairCounts count_and_clear(BitMask& rendered, const BitMask& observation, const BitMask& rim, const Box& box) {
+  return count_and_clear_impl<true>(rendered, observation, &rim, box);
 }
 
 }  // namespace gtrack::render
