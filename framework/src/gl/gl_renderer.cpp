@@ -267,7 +267,8 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
     gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
     gl_.BindTextureUnit(1, observation_);
     observation_count_ = 0;
-    observation_bits_.release();
+    texture_bits_.release();
+    texture_dirty_ = false;
   }
   gl_.check("setting the projection");
 }
@@ -280,38 +281,30 @@ void GlRenderer::set_observation(const cv::Mat& mask) {
                 std::to_string(s.height) + ", got " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
                 " of type " + std::to_string(mask.type()));
   }
-  // Bit 0 of the texture is O, bit 1 the rim (cleared here).
-  cv::compare(mask, 0, observation_bits_, cv::CMP_NE);
-  observation_bits_ &= 1;
-  observation_count_ = static_cast<std::uint64_t>(cv::countNonZero(observation_bits_));
-  upload_observation(observation_bits_);
+  // Bit 0 of the texture is O, bit 1 the rim (cleared here). The texture is
+  // uploaded once, by the next submit(), whatever rim follows.
+  cv::compare(mask, 0, texture_bits_, cv::CMP_NE);
+  texture_bits_ &= 1;
+  observation_count_ = static_cast<std::uint64_t>(cv::countNonZero(texture_bits_));
+  texture_dirty_ = true;
 }
 
 void GlRenderer::set_rim(const cv::Mat& rim) {
   if (!has_projection_) throw Error("gl backend: set_rim() before set_projection()");
   const ImageSize s = projection_.size;
-  if (rim.empty()) {
-    if (!observation_bits_.empty()) upload_observation(observation_bits_);
-    return;
-  }
-  if (rim.type() != CV_8UC1 || rim.cols != s.width || rim.rows != s.height) {
+  if (!rim.empty() && (rim.type() != CV_8UC1 || rim.cols != s.width || rim.rows != s.height)) {
     throw Error("gl backend: the rim must be CV_8U at the render size " + std::to_string(s.width) + "x" +
                 std::to_string(s.height) + ", got " + std::to_string(rim.cols) + "x" + std::to_string(rim.rows) +
                 " of type " + std::to_string(rim.type()));
   }
-  cv::Mat bits;
-  cv::compare(rim, 0, bits, cv::CMP_NE);
-  bits &= 2;
-  if (!observation_bits_.empty()) bits |= observation_bits_;
-  upload_observation(bits);
-}
-
-void GlRenderer::upload_observation(const cv::Mat& bits) {
-  const ImageSize s = projection_.size;
-  context_.make_current();
-  wait_for_fence();
-  gl_.TextureSubImage2D(observation_, 0, 0, 0, s.width, s.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE, bits.data);
-  gl_.check("uploading the observation");
+  if (texture_bits_.empty()) texture_bits_ = cv::Mat::zeros(s.height, s.width, CV_8UC1);
+  texture_bits_ &= 1;
+  if (!rim.empty()) {
+    cv::Mat bits;
+    cv::compare(rim, 0, bits, cv::CMP_NE);
+    texture_bits_ |= bits & 2;
+  }
+  texture_dirty_ = true;
 }
 
 void GlRenderer::require_ready(const char* what, Eigen::Index rows) const {
@@ -407,6 +400,15 @@ void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
   const int layers = layers_for(n);
   reserve_layers(layers);
   upload_hypotheses(hypotheses.data(), n);
+  if (texture_dirty_) {
+    // No batch is pending (finish() waited for the last one): the texture
+    // is free to change.
+    const ImageSize s = projection_.size;
+    gl_.TextureSubImage2D(observation_, 0, 0, 0, s.width, s.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+                          texture_bits_.data);
+    gl_.check("uploading the observation");
+    texture_dirty_ = false;
+  }
 
   static_assert(sizeof(PixelBox) == 4 * sizeof(GLint), "PixelBox must match the ivec4 boxes of count.comp");
   boxes_.assign(static_cast<size_t>(layers), PixelBox{});

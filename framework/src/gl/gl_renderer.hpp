@@ -49,7 +49,6 @@ class GlRenderer final : public Renderer {
   // Clears the target and draws hypotheses 0 .. count-1 into it.
   void draw(int count);
   void wait_for_fence();
-  void upload_observation(const cv::Mat& bits);
   void release() noexcept;
 
   EglContext context_;
@@ -62,7 +61,8 @@ class GlRenderer final : public Renderer {
   GLuint framebuffer_ = 0;
   GLuint target_ = 0;       // R32UI 2D array, one layer per 32 hypotheses
   GLuint observation_ = 0;  // R8UI: bit 0 O, bit 1 the rim
-  cv::Mat observation_bits_;  // O as uploaded (0 / 1), to combine with a rim
+  cv::Mat texture_bits_;      // the observation texture's bytes: bit 0 O, bit 1 the rim
+  bool texture_dirty_ = false;  // texture_bits_ not uploaded yet (done by submit())
   GLuint mesh_buffer_ = 0, finger_buffer_ = 0, link_buffer_ = 0;
   GLuint hypothesis_buffer_ = 0, box_buffer_ = 0, count_buffer_ = 0, readback_buffer_ = 0;
   const std::uint32_t* readback_ = nullptr;  // persistent, coherent mapping of readback_buffer_
