@@ -35,6 +35,12 @@ struct Observation {
   bool empty() const { return count == 0; }
 };
 
+// The occlusion rim of an observation mask (CV_8U, non-zero = observed):
+// the pixels within width_px of it (a (2 width_px + 1)-square dilation),
+// outside it, as 0/255; an empty Mat when width_px <= 0. The occlusion
+// budget never takes rendered pixels there as hidden (cost.hpp).
+GTRACK_API cv::Mat occlusion_rim(const cv::Mat& observed, int width_px);
+
 // What the previous frame says about this one.
 struct ObservationPrior {
   cv::Mat previous_mask;  // CV_8U at render size: P_t = f(g^_t, C)

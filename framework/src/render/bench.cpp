@@ -4,13 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
-#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "gtrack/config.hpp"
 #include "gtrack/cost.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/gripper.hpp"
+#include "gtrack/observation.hpp"
 #include "gtrack/plugin_loader.hpp"
 #include "gtrack/pso.hpp"
 
@@ -64,8 +64,7 @@ BenchScene make_bench_scene(const ArticulatedModel& model, int render_side, doub
   r->set_model(model);
   r->set_projection(s.projection, s.scale);
   s.observation = r->render_mask(s.nominal);
-  cv::dilate(s.observation, s.rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-  s.rim.setTo(0, s.observation);
+  s.rim = occlusion_rim(s.observation, 1);
   return s;
 }
 

@@ -100,4 +100,12 @@ Observation Segmenter::observe(const cv::Mat& frame, const ObservationPrior* pri
   return obs;
 }
 
+cv::Mat occlusion_rim(const cv::Mat& observed, int width_px) {
+  if (width_px <= 0) return {};
+  cv::Mat rim;
+  cv::dilate(observed, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * width_px + 1, 2 * width_px + 1)));
+  rim.setTo(0, observed);
+  return rim;
+}
+
 }  // namespace gtrack

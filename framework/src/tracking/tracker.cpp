@@ -3,9 +3,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
-
-#include <opencv2/imgproc.hpp>
 
 #include "coarse_search.hpp"
 #include "gtrack/error.hpp"
@@ -84,11 +81,7 @@ struct Tracker::Impl {
   void show_observation() {
     renderer->set_observation(observation.mask);
     const int k = config.cost.occlusion_rim_px;
-    if (k <= 0) return;
-    cv::Mat grown;
-    cv::dilate(observation.mask, grown, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * k + 1, 2 * k + 1)));
-    grown.setTo(0, observation.mask);
-    renderer->set_rim(grown);
+    if (k > 0) renderer->set_rim(occlusion_rim(observation.mask, k));
   }
 
   Eigen::VectorXd spread() const {
