@@ -1,13 +1,68 @@
-// Grid of hypotheses at the observation's centroid, then a PSO per candidate.
+// Grid of hypotheses at the observation's centroid, each also tried with its own
+// outline centred there; then a PSO per candidate.
 #include "coarse_search.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <numbers>
 #include <numeric>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 
 namespace gtrack::detail {
+
+namespace {
+
+// Where the outline of hypothesis h is centred, in render pixels: the
+// centroid of its mesh's projected triangles, weighted by their projected
+// area, each clipped first by the projection's clip planes (an ultrasound
+// slice sees only its slab). Surfaces facing the camera and facing away
+// both count, and so do overlaps, twice: close enough to place a grid
+// point, and no image is rendered or read back. None when nothing is seen.
+std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, const Projection& projection,
+                                                const Eigen::VectorXd& h, std::vector<Eigen::Vector3d>& vertices) {
+  model.pose(h, vertices);
+  const Eigen::Matrix<double, 3, 4>& P = projection.world_to_image;
+  Eigen::Vector2d sum(0, 0);
+  double area = 0;
+  std::vector<Eigen::Vector3d> polygon, clipped;
+  for (size_t t = 0; t + 2 < vertices.size(); t += 3) {
+    polygon.assign(vertices.begin() + static_cast<std::ptrdiff_t>(t),
+                   vertices.begin() + static_cast<std::ptrdiff_t>(t + 3));
+    for (const Eigen::Vector4d& plane : projection.clip_planes) {
+      // Sutherland-Hodgman against n.x + d >= 0.
+      clipped.clear();
+      for (size_t i = 0; i < polygon.size(); ++i) {
+        const Eigen::Vector3d& a = polygon[i];
+        const Eigen::Vector3d& b = polygon[(i + 1) % polygon.size()];
+        const double da = plane.head<3>().dot(a) + plane[3], db = plane.head<3>().dot(b) + plane[3];
+        if (da >= 0) clipped.push_back(a);
+        if ((da >= 0) != (db >= 0)) clipped.push_back(a + (b - a) * (da / (da - db)));
+      }
+      polygon.swap(clipped);
+      if (polygon.size() < 3) break;
+    }
+    if (polygon.size() < 3) continue;
+    std::vector<Eigen::Vector2d> q;
+    q.reserve(polygon.size());
+    for (const Eigen::Vector3d& x : polygon) {
+      const Eigen::Vector3d p = P * x.homogeneous();
+      if (p[2] <= 0) break;
+      q.push_back(p.head<2>() / p[2]);
+    }
+    if (q.size() != polygon.size()) continue;
+    // A fan of triangles from the first vertex; the clipped polygon is convex.
+    for (size_t k = 1; k + 1 < q.size(); ++k) {
+      const Eigen::Vector2d a = q[k] - q[0], b = q[k + 1] - q[0];
+      const double w = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+      sum += w * (q[0] + q[k] + q[k + 1]) / 3.0;
+      area += w;
+    }
+  }
+  if (area <= 0) return std::nullopt;
+  return sum / area;
+}
+
+}  // namespace
 
 Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen::Vector3d& near) {
   // The pixel's line of sight is {X : (p1 - u p3).[X;1] = 0, (p2 - v p3).[X;1] = 0};
@@ -25,6 +80,7 @@ Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen:
 
 CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig& config, CostEvaluator& cost,
                                  std::mt19937_64& rng) {
+  CoarseSearchResult result;
   const ParameterSpace& space = config.space;
   const ArticulatedModel& model = *in.model;
   const int dims = space.dims();
@@ -37,40 +93,77 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
   const double period = 360.0 / std::max(1, model.geometry().symmetry_order);
   const int rz_steps = tc.coarse_rz_steps;
   const double tilt = 25.0;
-  // Flat, then two rings of tilts: 25 deg about x or y, and 50 deg about x,
-  // y and the diagonals (strongly tilted, folded grippers have compact
-  // outlines that the first ring does not reach).
-  std::vector<std::pair<double, double>> tilts = {{0, 0}, {tilt, 0}, {-tilt, 0}, {0, tilt}, {0, -tilt}};
-  if (tc.coarse_wide_tilts) {
-    const double wide = 2 * tilt, diag = wide / std::numbers::sqrt2;
-    for (const auto& t : std::vector<std::pair<double, double>>{
-             {wide, 0}, {-wide, 0}, {0, wide}, {0, -wide}, {diag, diag}, {diag, -diag}, {-diag, diag}, {-diag, -diag}}) {
-      tilts.push_back(t);
+  // Flat, then two rings of tilts: 25 deg towards 4 directions of the image
+  // and 50 deg towards 8 (strongly tilted, folded grippers have compact
+  // outlines that the first ring does not reach). Each tilt is combined with
+  // every turn of the gripper about its own axis over one symmetry period:
+  // R = Rz(a) Rx(theta) Rz(tau), a the tilt's direction in the image, tau the
+  // turn. (A grid over the Euler angles' rz instead would turn a tilted
+  // gripper about the optical axis, which is not a symmetry: it would reach
+  // only a third of the tilted configurations.)
+  struct Ring {
+    double theta;
+    int directions;
+  };
+  std::vector<Ring> rings = {{0.0, 1}, {tilt, 4}};
+  if (tc.coarse_wide_tilts) rings.push_back({2 * tilt, 8});
+  std::vector<Eigen::Vector3d> rotations;  // (rx, ry, rz), degrees
+  for (const Ring& ring : rings) {
+    for (int a = 0; a < ring.directions; ++a) {
+      const double azimuth = 360.0 * a / ring.directions;
+      for (int r = 0; r < rz_steps; ++r) {
+        const double turn = period * r / rz_steps;
+        const Eigen::Matrix3d R = rotation_from_euler_deg(0, 0, azimuth) * rotation_from_euler_deg(ring.theta, 0, 0) *
+                                  rotation_from_euler_deg(0, 0, turn - azimuth);
+        rotations.push_back(euler_deg_from_rotation(R));
+      }
     }
   }
   std::vector<double> joints;
   for (int j = 0; j < 4; ++j) joints.push_back(in.joint_lo + (in.joint_hi - in.joint_lo) * j / 3.0);
 
-  Eigen::MatrixXd grid(dims, rz_steps * static_cast<int>(tilts.size() * joints.size()));
+  Eigen::MatrixXd grid(dims, static_cast<Eigen::Index>(rotations.size() * joints.size()));
   int col = 0;
-  for (int r = 0; r < rz_steps; ++r) {
-    for (const auto& [rx, ry] : tilts) {
-      for (double q : joints) {
-        Eigen::VectorXd h(dims);
-        h.head<3>() = centre;
-        h[3] = rx;
-        h[4] = ry;
-        h[5] = period * r / rz_steps;
-        h.tail(dims - kPoseDims).setConstant(q);
-        space.clamp(h);
-        grid.col(col++) = h;
-      }
+  for (const Eigen::Vector3d& rotation : rotations) {
+    for (double q : joints) {
+      Eigen::VectorXd h(dims);
+      h.head<3>() = centre;
+      h.segment<3>(3) = rotation;
+      h.tail(dims - kPoseDims).setConstant(q);
+      space.clamp(h);
+      grid.col(col++) = h;
     }
   }
-  CoarseSearchResult result;
   Eigen::VectorXd scores;
   cost.evaluate(grid, scores);
   result.evaluations += static_cast<std::uint64_t>(grid.cols());
+
+  // The palm centre is not the outline's centroid: a tilted, folded
+  // gripper's outline lies to one side of it, by up to a third of its size.
+  // Every grid point is also tried moved so that its outline's centroid
+  // falls on the observed one (one more batch), and keeps the better place.
+  if (mo.m00 > 0) {
+    const Eigen::Matrix<double, 3, 4>& P = in.render_projection.world_to_image;
+    Eigen::MatrixXd centred = grid;
+    std::vector<Eigen::Vector3d> vertices;
+    for (Eigen::Index i = 0; i < grid.cols(); ++i) {
+      const auto c = outline_centroid(model, in.render_projection, grid.col(i), vertices);
+      if (!c) continue;
+      const Eigen::Vector3d p = P * grid.col(i).head<3>().homogeneous();
+      const Eigen::Vector2d target = Eigen::Vector2d(p[0], p[1]) / p[2] + Eigen::Vector2d(u, v) - *c;
+      centred.col(i).head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
+      space.clamp(centred.col(i));
+    }
+    Eigen::VectorXd centred_scores;
+    cost.evaluate(centred, centred_scores);
+    result.evaluations += static_cast<std::uint64_t>(centred.cols());
+    for (Eigen::Index i = 0; i < grid.cols(); ++i) {
+      if (centred_scores[i] < scores[i]) {
+        grid.col(i) = centred.col(i);
+        scores[i] = centred_scores[i];
+      }
+    }
+  }
 
   std::vector<int> order(static_cast<size_t>(grid.cols()));
   std::iota(order.begin(), order.end(), 0);
