@@ -12,45 +12,39 @@ namespace gtrack::detail {
 
 namespace {
 
-// Where the outline of hypothesis h is centred, in render pixels: the
-// centroid of its mesh's projected triangles, weighted by their projected
-// area, each clipped first by the projection's clip planes (an ultrasound
-// slice sees only its slab). Surfaces facing the camera and facing away
-// both count, and so do overlaps, twice: close enough to place a grid
-// point, and no image is rendered or read back. None when nothing is seen.
+// Where the visible part of hypothesis h's outline is centred, in render
+// pixels: the centroid of its mesh's projected triangles (clipped by the
+// sensor's clip planes, as the renderers do, and by the image's borders),
+// weighted by their area. Surfaces facing the camera and facing away both
+// count, and so do overlaps, twice: close enough to place a grid point, and
+// no image is rendered or read back. None when nothing is in view.
 std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, const Projection& projection,
-                                                const Eigen::VectorXd& h, std::vector<Eigen::Vector3d>& vertices) {
+                                                const Eigen::VectorXd& h, std::vector<Eigen::Vector3d>& vertices,
+                                                std::vector<ScreenPolygon>& polygons) {
   model.pose(h, vertices);
-  const Eigen::Matrix<double, 3, 4>& P = projection.world_to_image;
+  project_and_clip(vertices, projection, polygons);
+  const double bound[4] = {0, static_cast<double>(projection.size.width), 0,
+                           static_cast<double>(projection.size.height)};
   Eigen::Vector2d sum(0, 0);
   double area = 0;
-  std::vector<Eigen::Vector3d> polygon, clipped;
-  for (size_t t = 0; t + 2 < vertices.size(); t += 3) {
-    polygon.assign(vertices.begin() + static_cast<std::ptrdiff_t>(t),
-                   vertices.begin() + static_cast<std::ptrdiff_t>(t + 3));
-    for (const Eigen::Vector4d& plane : projection.clip_planes) {
-      // Sutherland-Hodgman against n.x + d >= 0.
+  std::vector<Eigen::Vector2d> q, clipped;
+  for (const ScreenPolygon& polygon : polygons) {
+    q.assign(polygon.v, polygon.v + polygon.count);
+    // Sutherland-Hodgman against the four borders: x >= 0, x <= width, y >= 0, y <= height.
+    for (int e = 0; e < 4 && q.size() >= 3; ++e) {
+      const int axis = e / 2;
+      const double sign = e % 2 == 0 ? 1.0 : -1.0;
       clipped.clear();
-      for (size_t i = 0; i < polygon.size(); ++i) {
-        const Eigen::Vector3d& a = polygon[i];
-        const Eigen::Vector3d& b = polygon[(i + 1) % polygon.size()];
-        const double da = plane.head<3>().dot(a) + plane[3], db = plane.head<3>().dot(b) + plane[3];
+      for (size_t i = 0; i < q.size(); ++i) {
+        const Eigen::Vector2d& a = q[i];
+        const Eigen::Vector2d& b = q[(i + 1) % q.size()];
+        const double da = sign * (a[axis] - bound[e]), db = sign * (b[axis] - bound[e]);
         if (da >= 0) clipped.push_back(a);
         if ((da >= 0) != (db >= 0)) clipped.push_back(a + (b - a) * (da / (da - db)));
       }
-      polygon.swap(clipped);
-      if (polygon.size() < 3) break;
+      q.swap(clipped);
     }
-    if (polygon.size() < 3) continue;
-    std::vector<Eigen::Vector2d> q;
-    q.reserve(polygon.size());
-    for (const Eigen::Vector3d& x : polygon) {
-      const Eigen::Vector3d p = P * x.homogeneous();
-      if (p[2] <= 0) break;
-      q.push_back(p.head<2>() / p[2]);
-    }
-    if (q.size() != polygon.size()) continue;
-    // A fan of triangles from the first vertex; the clipped polygon is convex.
+    // A fan of triangles from the first vertex: the clipped polygon is convex.
     for (size_t k = 1; k + 1 < q.size(); ++k) {
       const Eigen::Vector2d a = q[k] - q[0], b = q[k + 1] - q[0];
       const double w = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
@@ -146,13 +140,21 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
     const Eigen::Matrix<double, 3, 4>& P = in.render_projection.world_to_image;
     Eigen::MatrixXd centred = grid;
     std::vector<Eigen::Vector3d> vertices;
+    std::vector<ScreenPolygon> polygons;
     for (Eigen::Index i = 0; i < grid.cols(); ++i) {
-      const auto c = outline_centroid(model, in.render_projection, grid.col(i), vertices);
-      if (!c) continue;
-      const Eigen::Vector3d p = P * grid.col(i).head<3>().homogeneous();
-      const Eigen::Vector2d target = Eigen::Vector2d(p[0], p[1]) / p[2] + Eigen::Vector2d(u, v) - *c;
-      centred.col(i).head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
-      space.clamp(centred.col(i));
+      // Twice: where the outline crosses the image's border, moving it
+      // changes its visible part.
+      for (int pass = 0; pass < 2; ++pass) {
+        auto h = centred.col(i);
+        const auto c = outline_centroid(model, in.render_projection, h, vertices, polygons);
+        if (!c) break;
+        const Eigen::Vector2d shift = Eigen::Vector2d(u, v) - *c;
+        if (shift.norm() < 0.25) break;
+        const Eigen::Vector3d p = P * h.head<3>().homogeneous();
+        const Eigen::Vector2d target = p.head<2>() / p[2] + shift;
+        h.head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
+        space.clamp(h);
+      }
     }
     Eigen::VectorXd centred_scores;
     cost.evaluate(centred, centred_scores);
