@@ -12,6 +12,13 @@ namespace gtrack::detail {
 
 namespace {
 
+struct OutlineScratch {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<ScreenPolygon> polygons;
+  std::vector<Eigen::Vector2d> q, clipped;
+  bool cut = false;  // the last outline crossed the image's border
+};
+
 // Where the visible part of hypothesis h's outline is centred, in render
 // pixels: the centroid of its mesh's projected triangles (clipped by the
 // sensor's clip planes, as the renderers do, and by the image's borders),
@@ -19,19 +26,23 @@ namespace {
 // count, and so do overlaps, twice: close enough to place a grid point, and
 // no image is rendered or read back. None when nothing is in view.
 std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, const Projection& projection,
-                                                const Eigen::VectorXd& h, std::vector<Eigen::Vector3d>& vertices,
-                                                std::vector<ScreenPolygon>& polygons) {
-  model.pose(h, vertices);
-  project_and_clip(vertices, projection, polygons);
+                                                const Eigen::Ref<const Eigen::VectorXd>& h, OutlineScratch& scratch) {
+  model.pose(h, scratch.vertices);
+  project_and_clip(scratch.vertices, projection, scratch.polygons);
   const double bound[4] = {0, static_cast<double>(projection.size.width), 0,
                            static_cast<double>(projection.size.height)};
   Eigen::Vector2d sum(0, 0);
   double area = 0;
-  std::vector<Eigen::Vector2d> q, clipped;
-  for (const ScreenPolygon& polygon : polygons) {
+  std::vector<Eigen::Vector2d>& q = scratch.q;
+  std::vector<Eigen::Vector2d>& clipped = scratch.clipped;
+  scratch.cut = false;
+  for (const ScreenPolygon& polygon : scratch.polygons) {
     q.assign(polygon.v, polygon.v + polygon.count);
+    const bool inside = std::all_of(q.begin(), q.end(), [&](const Eigen::Vector2d& x) {
+      return x.x() >= bound[0] && x.x() <= bound[1] && x.y() >= bound[2] && x.y() <= bound[3];
+    });
     // Sutherland-Hodgman against the four borders: x >= 0, x <= width, y >= 0, y <= height.
-    for (int e = 0; e < 4 && q.size() >= 3; ++e) {
+    for (int e = 0; e < 4 && !inside && q.size() >= 3; ++e) {
       const int axis = e / 2;
       const double sign = e % 2 == 0 ? 1.0 : -1.0;
       clipped.clear();
@@ -41,6 +52,7 @@ std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, c
         const double da = sign * (a[axis] - bound[e]), db = sign * (b[axis] - bound[e]);
         if (da >= 0) clipped.push_back(a);
         if ((da >= 0) != (db >= 0)) clipped.push_back(a + (b - a) * (da / (da - db)));
+        if (da < 0) scratch.cut = true;
       }
       q.swap(clipped);
     }
@@ -139,14 +151,13 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
   if (mo.m00 > 0) {
     const Eigen::Matrix<double, 3, 4>& P = in.render_projection.world_to_image;
     Eigen::MatrixXd centred = grid;
-    std::vector<Eigen::Vector3d> vertices;
-    std::vector<ScreenPolygon> polygons;
+    OutlineScratch scratch;
     for (Eigen::Index i = 0; i < grid.cols(); ++i) {
-      // Twice: where the outline crosses the image's border, moving it
-      // changes its visible part.
+      // Where the outline crosses the image's border, moving it changes its
+      // visible part: then a second pass.
       for (int pass = 0; pass < 2; ++pass) {
         auto h = centred.col(i);
-        const auto c = outline_centroid(model, in.render_projection, h, vertices, polygons);
+        const auto c = outline_centroid(model, in.render_projection, h, scratch);
         if (!c) break;
         const Eigen::Vector2d shift = Eigen::Vector2d(u, v) - *c;
         if (shift.norm() < 0.25) break;
@@ -154,6 +165,7 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
         const Eigen::Vector2d target = p.head<2>() / p[2] + shift;
         h.head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
         space.clamp(h);
+        if (!scratch.cut) break;
       }
     }
     Eigen::VectorXd centred_scores;
