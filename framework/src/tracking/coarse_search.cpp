@@ -8,6 +8,8 @@
 #include <optional>
 #include <opencv2/imgproc.hpp>
 
+#include "render/clip.hpp"
+
 namespace gtrack::detail {
 
 namespace {
@@ -15,52 +17,39 @@ namespace {
 struct OutlineScratch {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<ScreenPolygon> polygons;
-  std::vector<Eigen::Vector2d> q, clipped;
   bool cut = false;  // the last outline crossed the image's border
 };
 
 // Where the visible part of hypothesis h's outline is centred, in render
-// pixels: the centroid of its mesh's projected triangles (clipped by the
-// sensor's clip planes, as the renderers do, and by the image's borders),
-// weighted by their area. Surfaces facing the camera and facing away both
-// count, and so do overlaps, twice: close enough to place a grid point, and
-// no image is rendered or read back. None when nothing is in view.
+// pixels: the centroid of its mesh's projected triangles, clipped as the
+// renderers clip them (render::clip_triangle: the sensor's clip planes) but
+// to the image itself instead of a guard band around it, and weighted by
+// their area. Surfaces facing the camera and facing away both count, and so
+// do overlaps, twice: close enough to place a grid point, and no image is
+// rendered or read back. None when nothing is in view.
 std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, const Projection& projection,
                                                 const Eigen::Ref<const Eigen::VectorXd>& h, OutlineScratch& scratch) {
   model.pose(h, scratch.vertices);
-  project_and_clip(scratch.vertices, projection, scratch.polygons);
-  const double bound[4] = {0, static_cast<double>(projection.size.width), 0,
-                           static_cast<double>(projection.size.height)};
+  render::Frustum image = render::frustum_of(projection);
+  image.u_lo = 0;
+  image.u_hi = projection.size.width;
+  image.v_lo = 0;
+  image.v_hi = projection.size.height;
+  const std::vector<Eigen::Vector3d>& x = scratch.vertices;
+  scratch.polygons.clear();
+  scratch.cut = false;
+  for (size_t t = 0; t + 2 < x.size(); t += 3) {
+    for (size_t k = t; k < t + 3; ++k) scratch.cut |= !image.contains(render::project(projection, x[k]));
+    render::clip_triangle(x[t], x[t + 1], x[t + 2], projection, image, scratch.polygons);
+  }
   Eigen::Vector2d sum(0, 0);
   double area = 0;
-  std::vector<Eigen::Vector2d>& q = scratch.q;
-  std::vector<Eigen::Vector2d>& clipped = scratch.clipped;
-  scratch.cut = false;
-  for (const ScreenPolygon& polygon : scratch.polygons) {
-    q.assign(polygon.v, polygon.v + polygon.count);
-    const bool inside = std::all_of(q.begin(), q.end(), [&](const Eigen::Vector2d& x) {
-      return x.x() >= bound[0] && x.x() <= bound[1] && x.y() >= bound[2] && x.y() <= bound[3];
-    });
-    // Sutherland-Hodgman against the four borders: x >= 0, x <= width, y >= 0, y <= height.
-    for (int e = 0; e < 4 && !inside && q.size() >= 3; ++e) {
-      const int axis = e / 2;
-      const double sign = e % 2 == 0 ? 1.0 : -1.0;
-      clipped.clear();
-      for (size_t i = 0; i < q.size(); ++i) {
-        const Eigen::Vector2d& a = q[i];
-        const Eigen::Vector2d& b = q[(i + 1) % q.size()];
-        const double da = sign * (a[axis] - bound[e]), db = sign * (b[axis] - bound[e]);
-        if (da >= 0) clipped.push_back(a);
-        if ((da >= 0) != (db >= 0)) clipped.push_back(a + (b - a) * (da / (da - db)));
-        if (da < 0) scratch.cut = true;
-      }
-      q.swap(clipped);
-    }
-    // A fan of triangles from the first vertex: the clipped polygon is convex.
-    for (size_t k = 1; k + 1 < q.size(); ++k) {
-      const Eigen::Vector2d a = q[k] - q[0], b = q[k + 1] - q[0];
+  for (const ScreenPolygon& q : scratch.polygons) {
+    // A convex polygon: a fan of triangles from its first vertex.
+    for (int k = 1; k + 1 < q.count; ++k) {
+      const Eigen::Vector2d a = q.v[k] - q.v[0], b = q.v[k + 1] - q.v[0];
       const double w = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
-      sum += w * (q[0] + q[k] + q[k + 1]) / 3.0;
+      sum += w * (q.v[0] + q.v[k] + q.v[k + 1]) / 3.0;
       area += w;
     }
   }
