@@ -197,33 +197,47 @@ TEST(Tracker, OcclusionDiscountsRenderedPixelsOutsideO) {
 }
 
 TEST(Tracker, TheTemporalTermMeasuresThePoseAgainstItsConstantVelocity) {
-  // T is the mean of ((h_d - p_d) / spread_d)^2 over the six pose parameters,
-  // p = last + (last - before last) with depth held; the joints are left
-  // out. Recomputed here from the estimates themselves.
-  auto setup = make_setup();
-  auto config = gtrack::engine_config(setup);
-  config.tracker.redetect_dice = 1.0;
-  config.tracker.mirror_check = false;
-  ASSERT_GT(config.cost.temporal, 0.0);
-  gtrack::Tracker tracker(setup, config);
-  tracker.set_estimate(pose(0.3, -0.2, 20, 5));
-  std::vector<Eigen::VectorXd> h;
-  for (int i = 0; i < 4; ++i) {
-    // Moving and folding faster and faster: a joint velocity would not fit.
-    const auto e = tracker.process(scene(setup, pose(0.3 + 0.04 * i, -0.2, 20 + 2 * i, 5 + 3 * i * i), i + 1), i,
-                                   i / 30.0, 22.0);
-    ASSERT_EQ(e.status, gtrack::TrackStatus::Tracked);
-    h.push_back(e.hypothesis);
-    if (i < 2) continue;
-    Eigen::VectorXd p = h[i - 1] + (h[i - 1] - h[i - 2]);
-    p[2] = h[i - 1][2];
-    double t = 0;
-    for (int d = 0; d < gtrack::kPoseDims; ++d) {
-      double diff = h[i][d] - p[d];
-      if (d == 5) diff = std::remainder(diff, 360.0);
-      t += std::pow(diff / config.tracker.init_spread[d], 2);
+  // T is the mean of ((h_d - p_d) / sigma_d)^2 over the six pose parameters,
+  // p = last + (last - before last) with depth held, sigma = init_spread; and
+  // over the joints, p = the middle of the range the stimulus allows now,
+  // sigma = temporal_joint_sigma_deg (left out at 0). Recomputed here from
+  // the estimates themselves, with the joints in T and without.
+  for (const double joint_sigma : {3.0, 0.0}) {
+    auto setup = make_setup();
+    auto config = gtrack::engine_config(setup);
+    config.tracker.redetect_dice = 1.0;
+    config.tracker.mirror_check = false;
+    config.cost.temporal_joint_sigma_deg = joint_sigma;
+    ASSERT_GT(config.cost.temporal, 0.0);
+    gtrack::Tracker tracker(setup, config);
+    tracker.set_estimate(pose(0.3, -0.2, 20, 5));
+    std::vector<Eigen::VectorXd> h;
+    for (int i = 0; i < 4; ++i) {
+      // Moving and folding faster and faster: a joint velocity would not fit.
+      const auto e = tracker.process(scene(setup, pose(0.3 + 0.04 * i, -0.2, 20 + 2 * i, 5 + 3 * i * i), i + 1), i,
+                                     i / 30.0, 22.0);
+      ASSERT_EQ(e.status, gtrack::TrackStatus::Tracked);
+      h.push_back(e.hypothesis);
+      if (i < 2) continue;
+      Eigen::VectorXd p = h[i - 1] + (h[i - 1] - h[i - 2]);
+      p[2] = h[i - 1][2];
+      double t = 0;
+      for (int d = 0; d < gtrack::kPoseDims; ++d) {
+        double diff = h[i][d] - p[d];
+        if (d == 5) diff = std::remainder(diff, 360.0);
+        t += std::pow(diff / config.tracker.init_spread[d], 2);
+      }
+      int used = gtrack::kPoseDims;
+      if (joint_sigma > 0) {
+        const auto st = setup.stimulus->state();
+        ASSERT_LT(st.feasible_max_deg - st.feasible_min_deg, 100.0);  // a bounded range
+        const double middle = 0.5 * (st.feasible_min_deg + st.feasible_max_deg);
+        for (Eigen::Index d = gtrack::kPoseDims; d < h[i].size(); ++d, ++used) {
+          t += std::pow((h[i][d] - middle) / joint_sigma, 2);
+        }
+      }
+      EXPECT_NEAR(e.terms.temporal, t / used, 1e-9) << "frame " << i << ", joint sigma " << joint_sigma;
     }
-    EXPECT_NEAR(e.terms.temporal, t / gtrack::kPoseDims, 1e-9) << "frame " << i;
   }
 }
 
@@ -584,6 +598,7 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(c.cost.occlusion_discount, 0.0);  // paper
   // Additions on by default (docs/tracker.md); each has a value that turns it off.
   EXPECT_DOUBLE_EQ(c.cost.temporal, 0.001);  // lambda_temporal; 0 = paper
+  EXPECT_DOUBLE_EQ(c.cost.temporal_joint_sigma_deg, 3.0);  // 0 = joints left out of T
   EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_tolerance, 0.05);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_growth_weight, 0.1);

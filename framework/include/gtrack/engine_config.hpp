@@ -67,6 +67,14 @@ struct CostWeights {
   // well. With lambda_T > 0, particle 1 of the swarm also starts at the
   // prediction. 0 = paper.
   double temporal = 0.001;
+  // The joints' scale in T (deg): > 0 adds the joints to T, each against the
+  // prediction's joint (the middle of the range the stimulus allows now, or
+  // the last estimate's without a stimulus) in units of this value. Near
+  // flat a finger's outline barely changes with its fold (cos q), so the
+  // image leaves the joints free within a few degrees and the swarm ends
+  // anywhere there; this ties them to what the stimulus expects. 0 = the
+  // joints are left out of T.
+  double temporal_joint_sigma_deg = 3.0;
   // occlusion_discount in [0, 1]: when |O| falls below the area of the model
   // rendered at the previous estimate (ratio r < 1), rendered pixels outside
   // O are weighted w = 1 - occlusion_discount * (1 - r) in D (see cost.hpp).

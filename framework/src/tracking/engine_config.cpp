@@ -62,6 +62,8 @@ CostWeights read_cost(const ConfigTable& t) {
   c.kinematic = t.number_or("lambda_kinematic", c.kinematic, Range::non_negative());
   c.stimulus = t.number_or("lambda_stimulus", c.stimulus, Range::non_negative());
   c.temporal = t.number_or("lambda_temporal", c.temporal, Range::non_negative());
+  c.temporal_joint_sigma_deg =
+      t.number_or("temporal_joint_sigma_deg", c.temporal_joint_sigma_deg, Range::closed(0.0, 180.0));
   c.occlusion_discount = t.number_or("occlusion_discount", c.occlusion_discount, Range::closed(0.0, 1.0));
   c.occlusion_budget = t.number_or("occlusion_budget", c.occlusion_budget, Range::closed(0.0, 4.0));
   c.occlusion_tolerance = t.number_or("occlusion_tolerance", c.occlusion_tolerance, Range::closed(0.0, 1.0));

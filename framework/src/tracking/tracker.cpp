@@ -97,7 +97,7 @@ struct Tracker::Impl {
   // which T leaves out (they follow the stimulus, not a velocity).
   Eigen::VectorXd temporal_sigma() const {
     Eigen::VectorXd s = spread();
-    s.tail(s.size() - kPoseDims).setZero();
+    s.tail(s.size() - kPoseDims).setConstant(config.cost.temporal_joint_sigma_deg);
     return s;
   }
 
