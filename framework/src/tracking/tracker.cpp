@@ -93,8 +93,9 @@ struct Tracker::Impl {
     return s;
   }
 
-  // The temporal term's scales: the pose's spreads, and 0 for the joints,
-  // which T leaves out (they follow the stimulus, not a velocity).
+  // The temporal term's scales: the pose's spreads, and for the joints
+  // (measured against the fold the stimulus expects, not a velocity)
+  // temporal_joint_sigma_deg, 0 leaving them out.
   Eigen::VectorXd temporal_sigma() const {
     Eigen::VectorXd s = spread();
     s.tail(s.size() - kPoseDims).setConstant(config.cost.temporal_joint_sigma_deg);
