@@ -50,7 +50,7 @@ struct Tracker::Impl {
   // Below this tilt (deg) a result and its mirror are the same configuration.
   static constexpr double kMirrorMinTiltDeg = 3.0;
   // Re-detection replaces the track when its cost is below this share of the
-  // track's, times the share of the model observed (a larger gain under occlusion).
+  // track's.
   static constexpr double kRedetectGain = 0.7;
   // Spread multiplier of the re-detection's local swarm.
   static constexpr double kWideSpread = 3.0;
@@ -183,7 +183,6 @@ struct Tracker::Impl {
     }
     cost->set_outside_weight(outside_weight);
     set_allowance(searching ? 0 : previous_area);
-    double visible = visible_share(previous_area);
     e.outside_allowance = cost->outside_allowance();
     e.outside_weight = cost->outside_weight();
     e.observed_pixels = observation.count;
@@ -243,7 +242,6 @@ struct Tracker::Impl {
             observation = whole;
             show_observation();
             set_allowance(previous_area);
-            visible = visible_share(previous_area);
             current = score(best);
           }
           // The searches run without the temporal term, which would hold
@@ -266,9 +264,12 @@ struct Tracker::Impl {
           // only a clear gain counts: under occlusion many configurations
           // explain what is visible about equally well, and trading the
           // track for one of them on a marginal gain is a jump, not a fix.
-          // The more of the model is hidden, the larger the gain required.
+          // (The gain required does not grow with the hidden share: with the
+          // occlusion rim, a track gone wrong under an occluder scores well
+          // above the truth, and such a requirement kept it there;
+          // docs/tracker.md, re-detection.)
           if (alternative.total - lt * alternative.temporal <
-              kRedetectGain * visible * (current.total - lt * current.temporal)) {
+              kRedetectGain * (current.total - lt * current.temporal)) {
             best = found.best;
             terms = alternative;
             e.redetected = true;
@@ -338,13 +339,6 @@ struct Tracker::Impl {
     if (!reading && config.tracker.default_stimulus) reading = config.tracker.default_stimulus;
     if (reading && setup.stimulus) setup.stimulus->update(*reading, time_s);
     return reading;
-  }
-
-  // Share of the model at the previous estimate that is observed now.
-  double visible_share(std::uint64_t previous_area) const {
-    return previous_area > observation.count
-               ? static_cast<double>(observation.count) / static_cast<double>(previous_area)
-               : 1.0;
   }
 
   // The occlusion budget for the current observation against the model's
