@@ -678,10 +678,6 @@ TEST(Tracker, CoarseSearchFindsRandomPoses) {
   }
 }
 
-}  // namespace
-
-namespace {
-
 // The coarse search on strongly tilted grippers (40-50 deg, towards any
 // direction of the image, turned by any angle about their own axis). The
 // grid must hold every such configuration up to its refinements' spreads,
@@ -715,10 +711,6 @@ TEST(Tracker, CoarseSearchFindsStronglyTiltedPoses) {
   // rz 3, with neither 9.
   EXPECT_GE(found, 11);
 }
-
-}  // namespace
-
-namespace {
 
 // The coarse search on a gripper that is partly out of the image (its palm
 // centre 0.2 mm inside a border, about 45 % of it outside; any tilt up to

@@ -63,9 +63,10 @@ struct CostWeights {
   // lambda_T: weight of the temporal term T, the mean squared distance of a
   // hypothesis's pose to the constant-velocity prediction in units of
   // [tracker] init_spread (a diagonal Mahalanobis distance over the six pose
-  // parameters, and the joints with temporal_joint_sigma_deg below). A tie-breaker: under occlusion many poses explain O equally
-  // well. With lambda_T > 0, particle 1 of the swarm also starts at the
-  // prediction. 0 = paper.
+  // parameters, and the joints with temporal_joint_sigma_deg below). A
+  // tie-breaker: under occlusion many poses explain O equally well. With
+  // lambda_T > 0, particle 1 of the swarm also starts at the prediction.
+  // 0 = paper.
   double temporal = 0.001;
   // The joints' scale in T (deg): > 0 adds the joints to T, each against the
   // prediction's joint (the middle of the range the stimulus allows now, or

@@ -20,21 +20,28 @@ struct OutlineScratch {
   bool cut = false;  // the last outline crossed the image's border
 };
 
-// Where the visible part of hypothesis h's outline is centred, in render
-// pixels: the centroid of its mesh's projected triangles, clipped as the
-// renderers clip them (render::clip_triangle: the sensor's clip planes) but
-// to the image itself instead of a guard band around it, and weighted by
-// their area. Surfaces facing the camera and facing away both count, and so
-// do overlaps, twice: close enough to place a grid point, and no image is
-// rendered or read back. None when nothing is in view.
-std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, const Projection& projection,
-                                                const Eigen::Ref<const Eigen::VectorXd>& h, OutlineScratch& scratch) {
-  model.pose(h, scratch.vertices);
+// The renderers' frustum for `projection`, but bounded by the image itself
+// instead of a guard band around it.
+render::Frustum image_frustum(const Projection& projection) {
   render::Frustum image = render::frustum_of(projection);
   image.u_lo = 0;
   image.u_hi = projection.size.width;
   image.v_lo = 0;
   image.v_hi = projection.size.height;
+  return image;
+}
+
+// Where the visible part of hypothesis h's outline is centred, in render
+// pixels: the centroid of its mesh's projected triangles, clipped as the
+// renderers clip them (render::clip_triangle: the sensor's clip planes) but
+// to `image` (image_frustum), and weighted by their area. Surfaces facing
+// the camera and facing away both count, and so do overlaps, twice: close
+// enough to place a grid point, and no image is rendered or read back. None
+// when nothing is in view.
+std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, const Projection& projection,
+                                                const render::Frustum& image,
+                                                const Eigen::Ref<const Eigen::VectorXd>& h, OutlineScratch& scratch) {
+  model.pose(h, scratch.vertices);
   const std::vector<Eigen::Vector3d>& x = scratch.vertices;
   scratch.polygons.clear();
   scratch.cut = false;
@@ -138,7 +145,7 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
   // Every grid point is also tried moved so that its outline's centroid
   // falls on the observed one (one more batch), and keeps the better place.
   if (mo.m00 > 0) {
-    const Eigen::Matrix<double, 3, 4>& P = in.render_projection.world_to_image;
+    const render::Frustum image = image_frustum(in.render_projection);
     Eigen::MatrixXd centred = grid;
     OutlineScratch scratch;
     for (Eigen::Index i = 0; i < grid.cols(); ++i) {
@@ -146,12 +153,12 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
       // visible part: then a second pass.
       for (int pass = 0; pass < 2; ++pass) {
         auto h = centred.col(i);
-        const auto c = outline_centroid(model, in.render_projection, h, scratch);
+        const auto c = outline_centroid(model, in.render_projection, image, h, scratch);
         if (!c) break;
         const Eigen::Vector2d shift = Eigen::Vector2d(u, v) - *c;
         if (shift.norm() < 0.25) break;
-        const Eigen::Vector3d p = P * h.head<3>().homogeneous();
-        const Eigen::Vector2d target = p.head<2>() / p[2] + shift;
+        const Eigen::Vector2d target =
+            render::dehomogenise(render::project(in.render_projection, h.head<3>())) + shift;
         h.head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
         space.clamp(h);
         if (!scratch.cut) break;
