@@ -174,6 +174,29 @@ TEST(CpuRenderer, MasksEqualTheReferenceWithTiesOnTheTopView) {
   }
 }
 
+// padded_projection: the image's pixels are the padded canvas's, shifted by
+// the margin, and the canvas also holds what lies beyond the image's borders.
+TEST(CpuRenderer, PaddedProjectionExtendsTheImage) {
+  const ArticulatedModel model(hydrogel_geometry());
+  const Projection p = gtrack::scaled_projection(camera(), kScale);
+  const int mx = 40, my = 24;
+  auto in_image = cpu(model, p, 1.0, 1);
+  auto padded = cpu(model, gtrack::padded_projection(p, mx, my), 1.0, 1);
+  ASSERT_EQ(padded->render_size().width, p.size.width + 2 * mx);
+  ASSERT_EQ(padded->render_size().height, p.size.height + 2 * my);
+  const Eigen::MatrixXd H = random_hypotheses(200, 9, model.fingers());
+  int beyond = 0;
+  for (int i = 0; i < H.cols(); ++i) {
+    const cv::Mat small = in_image->render_mask(H.col(i));
+    const cv::Mat large = padded->render_mask(H.col(i));
+    ASSERT_TRUE(same_mask(large(cv::Rect(mx, my, p.size.width, p.size.height)), small)) << "hypothesis " << i;
+    ASSERT_GE(count(large), count(small));
+    beyond += count(large) > count(small);
+  }
+  EXPECT_GT(beyond, 10);  // some of them reach beyond a border
+  EXPECT_THROW(gtrack::padded_projection(p, -1, 0), gtrack::Error);
+}
+
 // The hydrogel gripper at a nominal pose in front of the test camera.
 struct NominalScene {
   ArticulatedModel model{hydrogel_geometry()};

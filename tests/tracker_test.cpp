@@ -453,6 +453,44 @@ TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
   EXPECT_DOUBLE_EQ(t.outside_allowance, 0.0);
 }
 
+// The budget's reference is the model's whole area, the part beyond the
+// image's border included: a gripper coming into view under an occluder shows
+// less of itself than the whole model, and the part the previous estimate had
+// beyond the border has come in since. Taken from the in-view area alone, the
+// allowance falls short of what is hidden and the track shrinks onto the
+// visible part.
+TEST(Tracker, OcclusionBudgetCountsThePartBeyondTheBorder) {
+  auto setup = make_setup();
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  // The same model on a canvas with a 64-pixel margin around the image.
+  gtrack::RenderOptions ro;
+  ro.backend = "cpu";
+  auto padded = gtrack::make_cpu_renderer(ro);
+  padded->set_model(setup.model());
+  padded->set_projection(gtrack::padded_projection(setup.sensor->projection(), 64, 64), 0.5);
+  // Nearly flat, its palm centre 96 px from the image's centre: the tips of
+  // the right-hand fingers are beyond the right border.
+  Eigen::VectorXd truth = pose(3.0, -0.2, 20, 2);
+  ASSERT_GT(cv::countNonZero(padded->render_mask(truth)),
+            cv::countNonZero(tracker.renderer().render_mask(truth)) + 100);
+  tracker.set_estimate(truth);
+  ASSERT_EQ(tracker.process(scene(setup, truth, 1), 0, 0.0, 22.0).status, gtrack::TrackStatus::Tracked);
+  for (int i = 1; i < 6; ++i) {
+    const Eigen::VectorXd previous = tracker.last_estimate().value();
+    const double whole = cv::countNonZero(padded->render_mask(previous));
+    truth[0] -= 0.1;  // coming into view, its left half hidden
+    const auto e = tracker.process(half_covered(tracker, setup, truth, i + 1), i, i / 30.0, 22.0);
+    EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
+    // All that O lacks of the previous model's whole area is allowed for,
+    // the part that was beyond the border included.
+    EXPECT_DOUBLE_EQ(e.outside_allowance, whole - static_cast<double>(e.observed_pixels)) << "frame " << i;
+    EXPECT_LT(e.terms.dice, 0.05) << "frame " << i;
+    EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
+    const double joints = (e.hypothesis.tail(6).array() - 2.0).abs().mean();
+    EXPECT_LT(joints, 10.0) << "frame " << i << ": " << e.hypothesis.transpose();
+  }
+}
+
 // Tracker::score (gtrack track --score-truth): a configuration scored after
 // a frame gets exactly the terms the estimate got, allowance and temporal
 // term included, and another configuration scores worse.

@@ -80,6 +80,10 @@ GTRACK_API bool hardware_gpu_available();
 
 // The projection scaled to render resolution.
 GTRACK_API Projection scaled_projection(const Projection& projection, double scale);
+// The same projection on a canvas grown by margin_x and margin_y pixels on
+// every side: pixel (u, v) becomes (u + margin_x, v + margin_y), so what lies
+// beyond the image's borders (up to the margin) is rendered too.
+GTRACK_API Projection padded_projection(const Projection& projection, int margin_x, int margin_y);
 
 // Geometry both backends share: the posed, projected and clipped triangles of
 // one hypothesis in render pixels (each polygon a fan after clipping). Used by

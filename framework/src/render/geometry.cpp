@@ -128,6 +128,18 @@ Projection scaled_projection(const Projection& projection, double scale) {
   return p;
 }
 
+Projection padded_projection(const Projection& projection, int margin_x, int margin_y) {
+  if (margin_x < 0 || margin_y < 0) throw Error("padded_projection: a margin cannot be negative");
+  Projection p = projection;
+  // u = r0.X / r2.X: adding m times the third row to the first adds m to u,
+  // for a perspective (pinhole) and an affine (ultrasound slice) row alike.
+  p.world_to_image.row(0) += margin_x * projection.world_to_image.row(2);
+  p.world_to_image.row(1) += margin_y * projection.world_to_image.row(2);
+  p.size.width += 2 * margin_x;
+  p.size.height += 2 * margin_y;
+  return p;
+}
+
 void project_and_clip(const std::vector<Eigen::Vector3d>& world_triangles, const Projection& projection,
                       std::vector<ScreenPolygon>& out) {
   out.clear();

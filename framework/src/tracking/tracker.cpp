@@ -40,6 +40,10 @@ struct Tracker::Impl {
   Setup setup;
   EngineConfig config;
   std::unique_ptr<Renderer> renderer;
+  // The occlusion budget's reference: the model rendered on a canvas that
+  // extends the image by half its size on every side (a cpu renderer of its
+  // own; one mask a frame, and only while the model reaches a border).
+  std::unique_ptr<Renderer> whole_view;
   std::unique_ptr<Segmenter> segmenter;
   std::unique_ptr<CostEvaluator> cost;
   Projection render_projection;
@@ -69,6 +73,15 @@ struct Tracker::Impl {
     const Projection projection = setup.sensor->projection();
     renderer->set_projection(projection, config.render.scale);
     render_projection = scaled_projection(projection, config.render.scale);
+    RenderOptions whole;
+    whole.backend = "cpu";
+    whole.threads = 1;
+    whole_view = make_cpu_renderer(whole);
+    whole_view->set_model(setup.model());
+    // Padded in render pixels, so that both canvases share one pixel grid.
+    whole_view->set_projection(
+        padded_projection(render_projection, render_projection.size.width / 2, render_projection.size.height / 2),
+        1.0);
     segmenter = std::make_unique<Segmenter>(config.observation, setup.sensor->image_size(), renderer->render_size());
     cost = std::make_unique<CostEvaluator>(std::vector<Renderer*>{renderer.get()}, *setup.gripper, nullptr,
                                            config.cost);
@@ -154,7 +167,7 @@ struct Tracker::Impl {
       ObservationPrior prior;
       prior.previous_mask = renderer->render_mask(*last);
       prior.margin_scale = 1.0 + lost;
-      previous_area = static_cast<std::uint64_t>(cv::countNonZero(prior.previous_mask));
+      previous_area = whole_area(*last, prior.previous_mask);
       observation = segmenter->observe(frame, &prior);
     } else {
       observation = segmenter->observe(frame, nullptr);
@@ -341,8 +354,21 @@ struct Tracker::Impl {
     return reading;
   }
 
+  // |P| of h, the part beyond the image's borders included: what the
+  // occlusion budget expects of O. A gripper entering the view under an
+  // occluder shows less than the whole model, and the part the previous
+  // estimate had beyond the border has come in since; the in-view area
+  // alone would leave the occluded part unallowed. `mask` is h rendered in
+  // the image; its area is the whole area unless it reaches a border.
+  std::uint64_t whole_area(const Eigen::VectorXd& h, const cv::Mat& mask) const {
+    const int last_row = mask.rows - 1, last_col = mask.cols - 1;
+    const bool at_border = cv::countNonZero(mask.row(0)) > 0 || cv::countNonZero(mask.row(last_row)) > 0 ||
+                           cv::countNonZero(mask.col(0)) > 0 || cv::countNonZero(mask.col(last_col)) > 0;
+    return static_cast<std::uint64_t>(cv::countNonZero(at_border ? whole_view->render_mask(h) : mask));
+  }
+
   // The occlusion budget for the current observation against the model's
-  // area at the previous estimate (0: none, e.g. when searching).
+  // whole area at the previous estimate (0: none, e.g. when searching).
   void set_allowance(std::uint64_t previous_area) {
     double allowance = 0, tolerance = 0;
     if (config.cost.occlusion_budget > 0 && previous_area > 0) {
