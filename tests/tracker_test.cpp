@@ -457,8 +457,9 @@ TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
 // image's border included: a gripper coming into view under an occluder shows
 // less of itself than the whole model, and the part the previous estimate had
 // beyond the border has come in since. Taken from the in-view area alone, the
-// allowance falls short of what is hidden and the track shrinks onto the
-// visible part.
+// allowance falls short of what is hidden (on the synthetic sequences the
+// track then gave way to a compact wrong configuration; in this small scene
+// it holds either way, so the allowance itself is what is checked).
 TEST(Tracker, OcclusionBudgetCountsThePartBeyondTheBorder) {
   auto setup = make_setup();
   gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
