@@ -220,6 +220,15 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     print_row("  about z", ev.in_view.axis_deg[2], "deg");
     print_row("joints", ev.in_view.joint_deg, "deg");
     print_row("phalanx endpoints", ev.in_view.endpoint_um, "um");
+    if (ev.tilt_mirror_frames > 0) {
+      // A diagnostic: how much of the orientation error is a flat gripper's
+      // tilt sign, which a view along the optical axis barely holds.
+      std::cout << "  tilt mirror of a flat gripper: " << ev.tilt_mirror_frames << " frames, "
+                << std::setprecision(0) << 100 * ev.tilt_mirror_orientation_share
+                << " % of the orientation error; orientation on the other frames " << std::setprecision(2)
+                << ev.orientation_without_tilt_mirror_deg.mean << " +- " << ev.orientation_without_tilt_mirror_deg.std
+                << " deg\n";
+    }
   }
   std::cout << "  recovery: " << ev.recovery.size() << " returns into view, " << ev.frames_lost_after_return
             << " frames lost or off track after them\n";

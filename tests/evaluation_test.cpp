@@ -1,6 +1,7 @@
 // The evaluator: symmetry, geodesic angles, lost and out-of-view frames, recovery, CSV errors.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <fstream>
 
 #include "gtrack/error.hpp"
@@ -72,6 +73,64 @@ TEST(Evaluation, GeodesicAngle) {
   EXPECT_LT(expected, 70);
   // The same rotation written on the other Euler branch.
   EXPECT_NEAR(gtrack::geodesic_angle_deg({20, 30, 40}, {20 + 180, 180 - 30, 40 + 180}), 0, 1e-9);
+}
+
+TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripper) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  const std::vector<double> flat(6, 0.0), folded(6, 30.0);
+  // Flat and tilted by 20 deg about x: the estimate tilted the other way is
+  // the mirror, 40 deg off; one tilted the same way with a small error is not.
+  const Eigen::VectorXd truth = pose(0, 0, 100, 20, 0, 15, flat);
+  const auto mirrored = gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -20, 0, 15, flat));
+  EXPECT_TRUE(mirrored.tilt_mirror);
+  EXPECT_NEAR(mirrored.orientation_deg, 40, 1e-6);
+  // The mirror is judged on the palm normal, whatever the turn about it.
+  EXPECT_TRUE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -18, 3, 70, flat)).tilt_mirror);
+  EXPECT_FALSE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 17, -2, 15, flat)).tilt_mirror);
+  // A folded truth's outline tells the tilts apart: never flagged.
+  EXPECT_FALSE(gtrack::compare_to_truth(m, pose(0, 0, 100, 20, 0, 15, folded), pose(0, 0, 100, -20, 0, 15, folded))
+                   .tilt_mirror);
+  // Nearly untilted: the two are the same configuration.
+  EXPECT_FALSE(
+      gtrack::compare_to_truth(m, pose(0, 0, 100, 2, 0, 0, flat), pose(0, 0, 100, -2, 0, 0, flat)).tilt_mirror);
+
+  // Judged about the line of sight: seen along x, the same pair is no mirror,
+  // and the mirror about x is.
+  EXPECT_FALSE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -20, 0, 15, flat), Eigen::Vector3d::UnitX())
+                   .tilt_mirror);
+  const Eigen::Vector3d n = gtrack::rotation_from_euler_deg(20, 0, 15).col(2);
+  const Eigen::Vector3d about_x(n.x(), -n.y(), -n.z());  // n turned by 180 deg about x
+  const Eigen::Vector3d turned = gtrack::euler_deg_from_rotation(
+      Eigen::Quaterniond::FromTwoVectors(n, about_x).toRotationMatrix() * gtrack::rotation_from_euler_deg(20, 0, 15));
+  EXPECT_TRUE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, turned.x(), turned.y(), turned.z(), flat), Eigen::Vector3d::UnitX())
+                  .tilt_mirror);
+
+  // A pinhole's line of sight runs from its centre through the point; a
+  // slice's (an affine projection) is the plane's normal everywhere.
+  gtrack::Projection pinhole;
+  pinhole.world_to_image << 1000, 0, 500, 0, 0, 1000, 500, 0, 0, 0, 1, 0;
+  EXPECT_LT((gtrack::line_of_sight(pinhole, {1, 2, 100}) - Eigen::Vector3d(1, 2, 100).normalized()).norm(), 1e-9);
+  gtrack::Projection slice;
+  slice.world_to_image << 10, 0, 0, 5, 0, 0, 10, 7, 0, 0, 0, 1;  // images x and z: the plane y = const
+  const Eigen::Vector3d d = gtrack::line_of_sight(slice, {3, 4, 5});
+  EXPECT_NEAR(std::abs(d.y()), 1, 1e-12);
+
+  // Over a sequence: the count, the share of the summed orientation error,
+  // and the other frames' error. Frames 0-1 mirrored (40 deg each), 2 off
+  // by 10 deg, 3 exact, 4 lost (not counted).
+  gtrack::PoseTable t, e;
+  t.fingers = e.fingers = 6;
+  for (int f = 0; f < 5; ++f) t.rows.push_back(row(f, truth));
+  e.rows = {row(0, pose(0, 0, 100, -20, 0, 15, flat)), row(1, pose(0, 0, 100, -20, 0, 15, flat)),
+            row(2, pose(0, 0, 100, 30, 0, 15, flat)), row(3, truth), row(4, truth, "lost")};
+  const auto ev = gtrack::evaluate(m, t, e);
+  EXPECT_EQ(ev.tilt_mirror_frames, 2);
+  EXPECT_NEAR(ev.tilt_mirror_orientation_share, 80.0 / 90.0, 1e-6);
+  EXPECT_EQ(ev.orientation_without_tilt_mirror_deg.count, 2);
+  EXPECT_NEAR(ev.orientation_without_tilt_mirror_deg.mean, 5, 1e-6);
+  EXPECT_NEAR(ev.in_view.orientation_deg.mean, 22.5, 1e-6) << "the headline error is unchanged";
+  EXPECT_NE(gtrack::evaluation_json(ev).find("\"tilt_mirror\": {\"frames\": 2"), std::string::npos);
 }
 
 TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {

@@ -53,11 +53,28 @@ struct FrameErrors {
   double joint_deg = 0;
   double endpoint_um = 0;
   int symmetry_k = 0;  // the equivalent of the estimate that was compared
+  // The truth is flat (every link within kFlatShare of the model's radius of
+  // the palm plane) and tilted by more than kMirrorMinTiltDeg from the line
+  // of sight v, and the estimate's palm normal lies nearer to the truth's
+  // tilt mirror (n turned by 180 degrees about v: 2 (n.v) v - n) than to n.
+  // Seen along v, a flat gripper and its tilt mirror cast the same outline
+  // but for perspective (a microscope), or cut the same slice (ultrasound,
+  // v the plane's normal): such a frame's orientation error is the tilt's
+  // sign, which the image barely holds. A diagnostic; it changes no error.
+  bool tilt_mirror = false;
+  static constexpr double kFlatShare = 0.05;
+  static constexpr double kMirrorMinTiltDeg = 3.0;
 };
 
 // Compares one estimate with one truth, modulo the model's symmetry.
+// `line_of_sight` (any length, either sign) is the sensor's viewing
+// direction at the truth's palm centre, for FrameErrors::tilt_mirror.
 GTRACK_API FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorXd& truth,
-                                        const Eigen::VectorXd& estimate);
+                                        const Eigen::VectorXd& estimate,
+                                        const Eigen::Vector3d& line_of_sight = Eigen::Vector3d::UnitZ());
+// The line of sight of `projection` through the image of `world_mm` (unit
+// length; the optical ray of a camera, the plane's normal of a slice).
+GTRACK_API Eigen::Vector3d line_of_sight(const Projection& projection, const Eigen::Vector3d& world_mm);
 // Angle (deg) of the rotation between two Euler triples (rx, ry, rz in deg).
 GTRACK_API double geodesic_angle_deg(const Eigen::Vector3d& euler_a, const Eigen::Vector3d& euler_b);
 
@@ -99,6 +116,12 @@ struct Evaluation {
   int off_track_frames = 0;   // in view, estimate present but endpoint error above the threshold
   ErrorSet in_view;           // the headline numbers
   ErrorSet out_of_view;       // frames mostly outside the view that still got an estimate
+  // Evaluated frames whose estimate is the tilt mirror of a flat truth
+  // (FrameErrors::tilt_mirror), the share of the summed orientation error
+  // they carry, and the orientation error of the other evaluated frames.
+  int tilt_mirror_frames = 0;
+  double tilt_mirror_orientation_share = 0;
+  ErrorStats orientation_without_tilt_mirror_deg;
   std::vector<RecoveryEpisode> recovery;
   int frames_lost_after_return = 0;
   std::vector<FrameEvaluation> per_frame;

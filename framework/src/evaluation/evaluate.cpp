@@ -89,7 +89,9 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
       ++ev.lost_frames;
       if (!fe.out_of_view) ++ev.lost_in_view_frames;
     } else {
-      fe.errors = compare_to_truth(model, t.h, it->second->h);
+      const Eigen::Vector3d sight =
+          sensor ? line_of_sight(sensor->projection(), t.h.head<3>()) : Eigen::Vector3d::UnitZ();
+      fe.errors = compare_to_truth(model, t.h, it->second->h, sight);
       if (fe.out_of_view) {
         ev.out_of_view.add(fe.errors);
       } else {
@@ -102,6 +104,20 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   }
   ev.in_view.finish();
   ev.out_of_view.finish();
+  std::vector<double> others;
+  double mirrored_sum = 0, all_sum = 0;
+  for (const FrameEvaluation& f : ev.per_frame) {
+    if (f.lost || f.out_of_view) continue;
+    all_sum += f.errors.orientation_deg;
+    if (f.errors.tilt_mirror) {
+      ++ev.tilt_mirror_frames;
+      mirrored_sum += f.errors.orientation_deg;
+    } else {
+      others.push_back(f.errors.orientation_deg);
+    }
+  }
+  ev.tilt_mirror_orientation_share = all_sum > 0 ? mirrored_sum / all_sum : 0;
+  ev.orientation_without_tilt_mirror_deg = stats(others);
 
   // Recovery: after each stretch out of view, frames until the estimate is
   // back on the gripper.

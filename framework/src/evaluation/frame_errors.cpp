@@ -1,4 +1,5 @@
 // One estimate against one truth, modulo the gripper's rotational symmetry.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -16,6 +17,26 @@ double mean_endpoint_distance(const std::vector<Eigen::Vector3d>& a, const std::
   return a.empty() ? 0.0 : sum / a.size();
 }
 
+// The estimate is the tilt mirror of a flat, tilted truth (FrameErrors::tilt_mirror).
+bool is_tilt_mirror(const ArticulatedModel& model, const Eigen::VectorXd& truth, const Eigen::VectorXd& estimate,
+                    const Eigen::Vector3d& line_of_sight) {
+  Eigen::VectorXd shape = truth;
+  shape.head<kPoseDims>().setZero();  // the model frame: the palm in its XY plane
+  double lo = 0, hi = 0;
+  for (const Eigen::Vector3d& p : model.link_endpoints(shape)) {
+    lo = std::min(lo, p.z());
+    hi = std::max(hi, p.z());
+  }
+  if (hi - lo > FrameErrors::kFlatShare * model.radius_mm()) return false;
+  if (line_of_sight.norm() == 0) return false;
+  const Eigen::Vector3d v = line_of_sight.normalized();
+  const Eigen::Vector3d n = rotation_from_euler_deg(truth[3], truth[4], truth[5]).col(2);
+  const Eigen::Vector3d m = 2 * n.dot(v) * v - n;
+  const Eigen::Vector3d e = rotation_from_euler_deg(estimate[3], estimate[4], estimate[5]).col(2);
+  const double tilt_deg = std::acos(std::clamp(std::abs(n.dot(v)), 0.0, 1.0)) * 180.0 / std::numbers::pi;
+  return tilt_deg > FrameErrors::kMirrorMinTiltDeg && e.dot(m) > e.dot(n);
+}
+
 }  // namespace
 
 double geodesic_angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -25,8 +46,21 @@ double geodesic_angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return Eigen::AngleAxisd(r).angle() * 180.0 / std::numbers::pi;
 }
 
+Eigen::Vector3d line_of_sight(const Projection& projection, const Eigen::Vector3d& world_mm) {
+  // The pixel's line of sight is {X : (p1 - u p3).[X;1] = 0, (p2 - v p3).[X;1] = 0};
+  // its direction is the cross product of the two planes' normals.
+  const Eigen::Matrix<double, 3, 4>& p = projection.world_to_image;
+  const Eigen::Vector3d x = p * world_mm.homogeneous();
+  if (x.z() == 0) return Eigen::Vector3d::UnitZ();
+  const double u = x.x() / x.z(), v = x.y() / x.z();
+  const Eigen::Vector3d a = (p.row(0) - u * p.row(2)).head<3>().transpose();
+  const Eigen::Vector3d b = (p.row(1) - v * p.row(2)).head<3>().transpose();
+  const Eigen::Vector3d d = a.cross(b);
+  return d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::UnitZ();
+}
+
 FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorXd& truth,
-                             const Eigen::VectorXd& estimate) {
+                             const Eigen::VectorXd& estimate, const Eigen::Vector3d& line_of_sight) {
   const auto truth_ends = model.link_endpoints(truth);
   const int order = std::max(1, model.geometry().symmetry_order);
   FrameErrors best;
@@ -54,6 +88,7 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
     f.joint_deg = F ? joints / F : 0;
     best = f;
   }
+  best.tilt_mirror = is_tilt_mirror(model, truth, estimate, line_of_sight);
   return best;
 }
 

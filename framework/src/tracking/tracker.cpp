@@ -281,8 +281,13 @@ struct Tracker::Impl {
           // occlusion rim, a track gone wrong under an occluder scores well
           // above the truth, and such a requirement kept it there;
           // docs/tracker.md, re-detection.)
-          if (alternative.total - lt * alternative.temporal <
-              kRedetectGain * (current.total - lt * current.temporal)) {
+          const bool taken = alternative.total - lt * alternative.temporal <
+                             kRedetectGain * (current.total - lt * current.temporal);
+          logger().debug("frame {}: re-detection (D without the rim {:.4f} > {}): track {:.4f}, best found {:.4f}: {}",
+                         index, tracked.dice_without_rim, config.tracker.redetect_dice,
+                         current.total - lt * current.temporal, alternative.total - lt * alternative.temporal,
+                         taken ? "taken" : "the track is kept");
+          if (taken) {
             best = found.best;
             terms = alternative;
             e.redetected = true;
@@ -310,6 +315,8 @@ struct Tracker::Impl {
         // (Its own mirror particles start back on the first branch: a
         // second, short look at both.)
         const PsoResult m = optimise_with(small, mirror, stimulus_on, rng);
+        logger().debug("frame {}: mirror check: result {:.4f}, its tilt mirror refined {:.4f}", index, terms.total,
+                       m.best_cost);
         if (m.best_cost < terms.total) {
           // Reported as mirrored only when the tilt did change branch.
           e.mirrored = m.best[3] * best[3] + m.best[4] * best[4] < 0;
