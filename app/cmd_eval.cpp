@@ -223,11 +223,15 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     if (ev.tilt_mirror_frames > 0) {
       // A diagnostic: how much of the orientation error is a flat gripper's
       // tilt sign, which a view along the optical axis barely holds.
-      std::cout << "  tilt mirror of a flat gripper: " << ev.tilt_mirror_frames << " frames, "
+      const auto& others = ev.orientation_without_tilt_mirror_deg;
+      std::cout << "  tilt mirror of a flat gripper: " << ev.tilt_mirror_frames << " frames, " << std::fixed
                 << std::setprecision(0) << 100 * ev.tilt_mirror_orientation_share
-                << " % of the orientation error; orientation on the other frames " << std::setprecision(2)
-                << ev.orientation_without_tilt_mirror_deg.mean << " +- " << ev.orientation_without_tilt_mirror_deg.std
-                << " deg\n";
+                << " % of the orientation error; orientation on the other frames ";
+      if (others.count > 0) {
+        std::cout << std::setprecision(2) << others.mean << " +- " << others.std << " deg\n";
+      } else {
+        std::cout << "none\n";
+      }
     }
   }
   std::cout << "  recovery: " << ev.recovery.size() << " returns into view, " << ev.frames_lost_after_return

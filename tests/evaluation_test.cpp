@@ -85,12 +85,15 @@ TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripper) {
   const auto mirrored = gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -20, 0, 15, flat));
   EXPECT_TRUE(mirrored.tilt_mirror);
   EXPECT_NEAR(mirrored.orientation_deg, 40, 1e-6);
-  // The mirror is judged on the palm normal, whatever the turn about it.
+  // The mirror is judged on the palm normal, whatever the turn about the
+  // optical axis.
   EXPECT_TRUE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -18, 3, 70, flat)).tilt_mirror);
   EXPECT_FALSE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 17, -2, 15, flat)).tilt_mirror);
   // A folded truth's outline tells the tilts apart: never flagged.
   EXPECT_FALSE(gtrack::compare_to_truth(m, pose(0, 0, 100, 20, 0, 15, folded), pose(0, 0, 100, -20, 0, 15, folded))
                    .tilt_mirror);
+  // Upside down is not the mirror.
+  EXPECT_FALSE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 20 + 180, 0, 15, flat)).tilt_mirror);
   // Nearly untilted: the two are the same configuration.
   EXPECT_FALSE(
       gtrack::compare_to_truth(m, pose(0, 0, 100, 2, 0, 0, flat), pose(0, 0, 100, -2, 0, 0, flat)).tilt_mirror);

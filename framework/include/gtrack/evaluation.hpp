@@ -56,7 +56,8 @@ struct FrameErrors {
   // The truth is flat (every link within kFlatShare of the model's radius of
   // the palm plane) and tilted by more than kMirrorMinTiltDeg from the line
   // of sight v, and the estimate's palm normal lies nearer to the truth's
-  // tilt mirror (n turned by 180 degrees about v: 2 (n.v) v - n) than to n.
+  // tilt mirror (n turned by 180 degrees about v: m = 2 (n.v) v - n) than to
+  // n or to -n (e.m > |e.n|).
   // Seen along v, a flat gripper and its tilt mirror cast the same outline
   // but for perspective (a microscope), or cut the same slice (ultrasound,
   // v the plane's normal): such a frame's orientation error is the tilt's

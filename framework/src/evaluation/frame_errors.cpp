@@ -34,7 +34,8 @@ bool is_tilt_mirror(const ArticulatedModel& model, const Eigen::VectorXd& truth,
   const Eigen::Vector3d m = 2 * n.dot(v) * v - n;
   const Eigen::Vector3d e = rotation_from_euler_deg(estimate[3], estimate[4], estimate[5]).col(2);
   const double tilt_deg = std::acos(std::clamp(std::abs(n.dot(v)), 0.0, 1.0)) * 180.0 / std::numbers::pi;
-  return tilt_deg > FrameErrors::kMirrorMinTiltDeg && e.dot(m) > e.dot(n);
+  // Nearer the mirror than the truth, and not upside down (e near -n).
+  return tilt_deg > FrameErrors::kMirrorMinTiltDeg && e.dot(m) > std::abs(e.dot(n));
 }
 
 }  // namespace
