@@ -112,10 +112,7 @@ cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int index, Synth
 
   // Gripper on the enlarged canvas.
   const Projection proj = sensor.projection();
-  Projection canvas = proj;
-  canvas.world_to_image.row(0) += margin * proj.world_to_image.row(2);
-  canvas.world_to_image.row(1) += margin * proj.world_to_image.row(2);
-  canvas.size = {W + 2 * margin, H + 2 * margin};
+  const Projection canvas = padded_projection(proj, margin, margin);
   const auto shaded = gripper_polygons(model, fr, canvas);
   std::vector<Eigen::Vector2d> all;
   for (const auto& s : shaded) all.insert(all.end(), s.poly.v, s.poly.v + s.poly.count);
