@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "gtrack/evaluation.hpp"
 
@@ -66,6 +67,9 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   std::map<int, const PoseRow*> by_frame;
   for (const auto& r : estimates.rows) by_frame[r.frame] = &r;
   const bool dims_match = estimates.fingers == model.fingers();
+  const std::optional<Projection> projection = sensor ? std::optional<Projection>(sensor->projection()) : std::nullopt;
+  std::vector<double> unmirrored;  // orientation errors of in-view frames that are no tilt mirror
+  double mirrored_sum = 0, orientation_sum = 0;
 
   for (const PoseRow& t : truth.rows) {
     FrameEvaluation fe;
@@ -90,13 +94,20 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
       if (!fe.out_of_view) ++ev.lost_in_view_frames;
     } else {
       const Eigen::Vector3d sight =
-          sensor ? line_of_sight(sensor->projection(), t.h.head<3>()) : Eigen::Vector3d::UnitZ();
+          projection ? line_of_sight(*projection, t.h.head<3>()) : Eigen::Vector3d::UnitZ();
       fe.errors = compare_to_truth(model, t.h, it->second->h, sight);
       if (fe.out_of_view) {
         ev.out_of_view.add(fe.errors);
       } else {
         ev.in_view.add(fe.errors);
         ++ev.evaluated_frames;
+        orientation_sum += fe.errors.orientation_deg;
+        if (fe.errors.tilt_mirror) {
+          ++ev.tilt_mirror_frames;
+          mirrored_sum += fe.errors.orientation_deg;
+        } else {
+          unmirrored.push_back(fe.errors.orientation_deg);
+        }
         if (fe.errors.endpoint_um > options.off_track_endpoint_um) ++ev.off_track_frames;
       }
     }
@@ -104,20 +115,8 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   }
   ev.in_view.finish();
   ev.out_of_view.finish();
-  std::vector<double> others;
-  double mirrored_sum = 0, all_sum = 0;
-  for (const FrameEvaluation& f : ev.per_frame) {
-    if (f.lost || f.out_of_view) continue;
-    all_sum += f.errors.orientation_deg;
-    if (f.errors.tilt_mirror) {
-      ++ev.tilt_mirror_frames;
-      mirrored_sum += f.errors.orientation_deg;
-    } else {
-      others.push_back(f.errors.orientation_deg);
-    }
-  }
-  ev.tilt_mirror_orientation_share = all_sum > 0 ? mirrored_sum / all_sum : 0;
-  ev.orientation_without_tilt_mirror_deg = stats(others);
+  ev.tilt_mirror_orientation_share = orientation_sum > 0 ? mirrored_sum / orientation_sum : 0;
+  ev.orientation_without_tilt_mirror_deg = stats(unmirrored);
 
   // Recovery: after each stretch out of view, frames until the estimate is
   // back on the gripper.
