@@ -16,10 +16,14 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   o.frames = vm["frames"].as<int>();
   o.seed = gtrack::cli::seed_option(vm);
   o.joint_noise_deg = vm["joint-noise"].as<double>();
+  o.occlusion_scale = vm["occlusion-scale"].as<double>();
   o.threads = vm["threads"].as<int>();
   if (o.threads < 0) throw gtrack::cli::UsageError("--threads must be 0 (all cores) or more");
   if (o.frames < 1) throw gtrack::cli::UsageError("--frames must be at least 1");
   if (o.joint_noise_deg < 0) throw gtrack::cli::UsageError("--joint-noise must not be negative");
+  if (!(o.occlusion_scale >= 0 && o.occlusion_scale <= 1)) {
+    throw gtrack::cli::UsageError("--occlusion-scale must be in [0, 1]");
+  }
   const gtrack::SynthPreset& preset = gtrack::synth_preset(o.preset);
   const std::filesystem::path config = vm.count("config") ? std::filesystem::path(vm["config"].as<std::string>())
                                                           : gtrack::data_dir() / "configs" / preset.config;
@@ -53,6 +57,9 @@ GTRACK_COMMAND(
           "preset", po::value<std::string>()->default_value("microscope"), "setup: motion, look and noise")(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(
+          "occlusion-scale", po::value<double>()->default_value(1.0),
+          "multiplies each occluder's share of the shape, in [0, 1]; 0 = no occluders, the rest of the sequence "
+          "unchanged")(
           "threads", po::value<int>()->default_value(0), "frames drawn in parallel (0 = all cores)");
     },
     run_synth)

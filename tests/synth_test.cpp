@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "gtrack/engine_config.hpp"
+#include "gtrack/error.hpp"
 #include "gtrack/observation.hpp"
 #include "gtrack/renderer.hpp"
 #include "gtrack/sequence_io.hpp"
@@ -64,6 +65,46 @@ TEST(Synth, SameSeedSameSequence) {
   EXPECT_NE(a.frames[5].truth, c.frames[5].truth);
   const cv::Mat fa = gtrack::render_frame(setup, a, 9, nullptr), fb = gtrack::render_frame(setup, b, 9, nullptr);
   EXPECT_EQ(cv::norm(fa, fb, cv::NORM_INF), 0);
+}
+
+TEST(Synth, OcclusionScaleShrinksTheOccludersAndKeepsTheRest) {
+  const gtrack::Setup setup = microscope();
+  gtrack::SynthOptions o;
+  o.frames = 150;
+  o.seed = 2;
+  const auto full = gtrack::plan_sequence(setup, o);
+  o.occlusion_scale = 0.5;
+  const auto half = gtrack::plan_sequence(setup, o);
+  o.occlusion_scale = 0;
+  const auto none = gtrack::plan_sequence(setup, o);
+  int occluded = 0;
+  for (int i = 0; i < o.frames; ++i) {
+    EXPECT_EQ(full.frames[i].truth, none.frames[i].truth) << "frame " << i;
+    EXPECT_EQ(full.frames[i].stimulus, none.frames[i].stimulus) << "frame " << i;
+    EXPECT_FALSE(none.frames[i].occluder.active) << "frame " << i;
+    EXPECT_DOUBLE_EQ(half.frames[i].occluder.target, 0.5 * full.frames[i].occluder.target) << "frame " << i;
+    EXPECT_EQ(half.frames[i].occluder.offset_px, full.frames[i].occluder.offset_px) << "frame " << i;
+    if (full.frames[i].occluder.active) ++occluded;
+  }
+  EXPECT_GT(occluded, 30);
+  // The same frame drawn without its occluder differs only where it was.
+  int shown = -1;
+  for (int i = 0; i < o.frames && shown < 0; ++i) {
+    if (full.frames[i].occluder.target > 0.3) shown = i;
+  }
+  ASSERT_GE(shown, 0);
+  gtrack::SynthVisibility vf, vn;
+  const cv::Mat a = gtrack::render_frame(setup, full, shown, &vf), b = gtrack::render_frame(setup, none, shown, &vn);
+  EXPECT_GT(vf.occluded, 0.2);
+  EXPECT_EQ(vn.occluded, 0);
+  EXPECT_EQ(vn.in_view, vf.in_view);
+  cv::Mat diff;
+  cv::absdiff(a, b, diff);
+  cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::countNonZero(diff), 0);
+  EXPECT_LT(cv::countNonZero(diff), diff.total() / 4);
+  o.occlusion_scale = 1.5;
+  EXPECT_THROW(gtrack::plan_sequence(setup, o), gtrack::Error);
 }
 
 TEST(Synth, PlanHasOcclusionsExitsTiltsAndFolding) {

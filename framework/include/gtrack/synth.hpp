@@ -80,6 +80,11 @@ struct SynthOptions {
   // the finger's joint value, drawn anew per frame; the ground truth keeps
   // the finger's value.
   double joint_noise_deg = 0;
+  // Multiplies every occluder's planned share of the shape, in [0, 1]; 0
+  // draws no occluders. The occluders are planned as at 1, so the motion,
+  // the fold, the stimulus and the noise of a seed stay the same: the same
+  // sequence with smaller occluders, or none.
+  double occlusion_scale = 1;
   int threads = 0;  // frames drawn in parallel; 0 = hardware concurrency
 };
 

@@ -104,6 +104,9 @@ std::vector<OccluderPlan> plan_occlusions(const SynthPreset& p, int frames, doub
 
 SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   if (options.frames < 1) throw Error("a synthetic sequence needs at least one frame");
+  if (!(options.occlusion_scale >= 0 && options.occlusion_scale <= 1)) {
+    throw Error("the occlusion scale must be in [0, 1]");
+  }
   SynthPlan plan;
   plan.preset = synth_preset(options.preset);
   plan.options = options;
@@ -132,6 +135,10 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   const auto exits = plan_exits(p, duration, half_view, radius, nominal.head<2>(), rng);
   const auto temperature = stimulus_profile(p, times, duration, rng);
   auto occluders = plan_occlusions(p, n, fps, rng);
+  for (OccluderPlan& o : occluders) {
+    o.target *= options.occlusion_scale;
+    if (o.target <= 0) o.active = false;
+  }
 
   const double rz0 = 360 * u(rng) - 180, spin_sign = u(rng) < 0.5 ? -1 : 1;
 

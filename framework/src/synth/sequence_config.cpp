@@ -46,8 +46,9 @@ void write_sequence_config(const std::filesystem::path& input_config, const Synt
       << "#   gtrack track --config sequence.toml --input frames --stimulus stimulus.csv --out track\n"
       << "# Made by 'gtrack synth' from " << fs::absolute(input_config).string() << "\n"
       << "# (preset '" << plan.preset.name << "', seed " << plan.options.seed << ", " << plan.frames.size()
-      << " frames). Holds no ground truth: tracking starts from the coarse search.\n\n"
-      << root << "\n";
+      << " frames";
+  if (plan.options.occlusion_scale != 1) out << ", occlusion scale " << plan.options.occlusion_scale;
+  out << "). Holds no ground truth: tracking starts from the coarse search.\n\n" << root << "\n";
   if (!out) throw InputError(out_file.string() + ": write failed");
 }
 
