@@ -18,6 +18,7 @@
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/tracker.hpp"
+#include "gtrack/tracker_state.hpp"
 
 namespace fs = std::filesystem;
 
@@ -114,6 +115,53 @@ TEST(Tracker, CoarseSearchFindsTheGripperOnTheFirstFrame) {
   EXPECT_LT(e.terms.dice, 0.12) << e.hypothesis.transpose();
   EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.06) << e.hypothesis.transpose();
   EXPECT_GT(e.evaluations, 800u);
+}
+
+// A gripper moving three times the swarm's x spread per frame: frame 1 is
+// found again by re-detection, and the step between the two found estimates
+// starts particle 1 of frame 2, which then follows without re-detection.
+// The step is part of the tracker's state (it survives a resume).
+TEST(Tracker, TheStepBetweenTwoFoundFramesStartsTheNextSwarm) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  gtrack::Tracker tracker(setup, config);
+  const double step = 0.6;
+  const auto truth = [&](int i) { return pose(-1.2 + step * i, 0.1, 30, 0); };
+  const auto e0 = tracker.process(scene(setup, truth(0), 1), 0, 0.0, 22.0);
+  ASSERT_EQ(e0.status, gtrack::TrackStatus::Search);
+  EXPECT_TRUE(tracker.state().last_found);
+  EXPECT_FALSE(tracker.state().found_step);
+  const auto e1 = tracker.process(scene(setup, truth(1), 2), 1, 1 / 30.0, 22.0);
+  ASSERT_TRUE(e1.redetected) << e1.hypothesis.transpose();
+  const auto s1 = tracker.state();
+  ASSERT_TRUE(s1.found_step);
+  EXPECT_NEAR((*s1.found_step)[0], step, 0.1);
+  EXPECT_NEAR((*s1.found_step)[1], 0, 0.1);
+  const auto e2 = tracker.process(scene(setup, truth(2), 3), 2, 2 / 30.0, 22.0);
+  EXPECT_FALSE(e2.redetected);
+  EXPECT_LT((e2.hypothesis.head<2>() - truth(2).head<2>()).norm(), 0.06) << e2.hypothesis.transpose();
+  EXPECT_FALSE(tracker.state().last_found);
+  EXPECT_FALSE(tracker.state().found_step);
+
+  // Through the state file.
+  const fs::path file = temp_dir("found_step") / "tracker_state.txt";
+  gtrack::write_tracker_state(file, s1);
+  const gtrack::TrackerState back = gtrack::read_tracker_state(file);
+  EXPECT_TRUE(back.last_found);
+  ASSERT_TRUE(back.found_step);
+  EXPECT_EQ(*back.found_step, *s1.found_step);
+  gtrack::Tracker resumed(setup, config);
+  resumed.restore(back);
+  EXPECT_EQ(*resumed.state().found_step, *s1.found_step);
+  std::ofstream(file) << "gtrack-tracker-state 1\nframe 1\nfound_step 1 2 3\n";
+  try {
+    gtrack::read_tracker_state(file);
+    ADD_FAILURE() << "a found step of three values was read";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tracker_state.txt:3: expected '-' or two values (x, y) after 'found_step'"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Tracker, FollowsAMovingFoldingGripper) {

@@ -8,6 +8,8 @@
 //   reference_area 0
 //   last 0.28088680263448867 -0.65538763658777754 100.09506213033944 ...
 //   before_last -
+//   last_found 0
+//   found_step -
 //
 // The configurations are written with 17 significant digits, so a resumed
 // run starts from exactly the values the interrupted one held.
@@ -29,6 +31,10 @@ namespace gtrack {
 struct TrackerState {
   int frame = -1;  // the last frame processed; -1 = none
   std::optional<Eigen::VectorXd> last, before_last;
+  // `last` came from a search (coarse search or re-detection); the x, y step
+  // between two such estimates of consecutive frames (none: -).
+  bool last_found = false;
+  std::optional<Eigen::VectorXd> found_step;
   int lost = 0;
   bool started = false;
   std::uint64_t reference_area = 0;

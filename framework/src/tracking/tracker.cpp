@@ -49,6 +49,11 @@ struct Tracker::Impl {
   Projection render_projection;
   std::optional<Eigen::VectorXd> last;
   std::optional<Eigen::VectorXd> before_last;  // the estimate before `last`, both tracked: the velocity
+  // `last` was found by a search (the coarse search or re-detection), not
+  // tracked; and the x, y step between two such estimates of consecutive
+  // frames, which starts particle 1 of the next frame.
+  bool last_found = false;
+  std::optional<Eigen::Vector2d> found_step;
   std::uint64_t reference_area = 0;  // |P| when O last covered the whole model (0 = none yet)
   static constexpr double kCompleteRatio = 0.9;
   // Below this tilt (deg) a result and its mirror are the same configuration.
@@ -205,6 +210,7 @@ struct Tracker::Impl {
     if (observation.empty()) {
       ++lost;
       before_last.reset();
+      forget_found();
       e.status = TrackStatus::Lost;
       e.hypothesis = last ? *last : fallback_pose();
       show_observation();
@@ -231,7 +237,12 @@ struct Tracker::Impl {
         reference_area = 0;
         terms = score(best);
       } else {
-        best = optimise(*last, stimulus_on, rng, prediction ? &*prediction : nullptr);
+        std::optional<Eigen::VectorXd> guess = prediction;
+        if (guess && found_step) {
+          guess->head<2>() += *found_step;
+          config.space.clamp(*guess);
+        }
+        best = optimise(*last, stimulus_on, rng, guess ? &*guess : nullptr);
         e.status = TrackStatus::Tracked;
         const CostTerms tracked = score(best);
         terms = tracked;
@@ -333,16 +344,26 @@ struct Tracker::Impl {
         e.status = TrackStatus::Lost;
         if (!last) last = best;
         before_last.reset();
+        forget_found();
         e.hypothesis = best;
       } else {
         lost = 0;
         // A velocity needs two estimates of one continuous track: not across
         // a search, a re-detection or a switch to the mirror branch.
+        found_step.reset();
         if (e.status == TrackStatus::Tracked && last && !e.redetected && !e.mirrored) {
           before_last = last;
         } else {
           before_last.reset();
+          // Two consecutive frames found by a search: a gripper moving
+          // faster than the swarm's spreads (typically coming back into
+          // view), which the track keeps losing. The step between the two
+          // is its motion more often than not; it starts particle 1 of the
+          // next frame, but the temporal term, which a wrong step would
+          // make pay for the right configuration, does not use it.
+          if (e.redetected && last_found) found_step = (best - *last).head<2>();
         }
+        last_found = e.status == TrackStatus::Search || e.redetected;
         last = best;
         e.hypothesis = best;
       }
@@ -351,6 +372,11 @@ struct Tracker::Impl {
     e.times.pso_ms = ms_since(t1);
     e.ms = ms_since(t0);
     return e;
+  }
+
+  void forget_found() {
+    last_found = false;
+    found_step.reset();
   }
 
   // The reading in force for a frame (the configured default when there is
@@ -464,8 +490,9 @@ struct Tracker::Impl {
       init(4, i) -= 2 * start[4];
       config.space.clamp(init.col(i));
     }
-    // Particle 1 starts at the constant-velocity prediction (particle 0 stays
-    // at the previous best, as in the paper).
+    // Particle 1 starts at the constant-velocity prediction, or where the
+    // found step leads (particle 0 stays at the previous best, as in the
+    // paper).
     if (prediction && config.cost.temporal > 0 && init.cols() - mirrors > 1) init.col(1) = *prediction;
     ParticleSwarm pso(pso_config, config.space);
     pso.set_randomization_spread(s);
@@ -488,6 +515,7 @@ Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::o
 void Tracker::reset() {
   impl_->last.reset();
   impl_->before_last.reset();
+  impl_->forget_found();
   impl_->reference_area = 0;
   impl_->started = false;
   impl_->last_frame = -1;
@@ -499,6 +527,8 @@ TrackerState Tracker::state() const {
   s.frame = impl_->last_frame;
   s.last = impl_->last;
   s.before_last = impl_->before_last;
+  s.last_found = impl_->last_found;
+  if (impl_->found_step) s.found_step = Eigen::VectorXd(*impl_->found_step);
   s.lost = impl_->lost;
   s.started = impl_->started;
   s.reference_area = impl_->reference_area;
@@ -513,9 +543,15 @@ void Tracker::restore(const TrackerState& s) {
                   std::to_string(dims));
     }
   }
+  if (s.found_step && s.found_step->size() != 2) {
+    throw Error("holds a found step of " + std::to_string(s.found_step->size()) + " values, expected 2 (x, y)");
+  }
   impl_->last_frame = s.frame;
   impl_->last = s.last;
   impl_->before_last = s.before_last;
+  impl_->last_found = s.last_found;
+  impl_->found_step.reset();
+  if (s.found_step) impl_->found_step = Eigen::Vector2d((*s.found_step)[0], (*s.found_step)[1]);
   impl_->lost = s.lost;
   impl_->started = s.started;
   impl_->reference_area = s.reference_area;
@@ -531,6 +567,7 @@ void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
   }
   impl_->last = hypothesis;
   impl_->before_last.reset();
+  impl_->forget_found();
   impl_->started = true;
   impl_->lost = 0;
 }

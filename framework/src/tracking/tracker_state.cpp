@@ -45,6 +45,8 @@ void write_tracker_state(const fs::path& file, const TrackerState& s) {
       << "reference_area " << s.reference_area << "\n";
   write_vector(out, "last", s.last);
   write_vector(out, "before_last", s.before_last);
+  out << "last_found " << (s.last_found ? 1 : 0) << "\n";
+  write_vector(out, "found_step", s.found_step);
   detail::replace_file(file, out.str());
 }
 
@@ -70,7 +72,7 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
       header = true;
       continue;
     }
-    if (key == "last" || key == "before_last") {
+    if (key == "last" || key == "before_last" || key == "found_step") {
       std::vector<double> v;
       std::string tok;
       bool none = false;
@@ -85,7 +87,11 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
         v.push_back(x);
       }
       if (none != v.empty()) fail("expected '-' or the values of a configuration after '" + key + "'");
-      if (!none) (key == "last" ? s.last : s.before_last) = Eigen::Map<Eigen::VectorXd>(v.data(), v.size());
+      if (!none) {
+        if (key == "found_step" && v.size() != 2) fail("expected '-' or two values (x, y) after 'found_step'");
+        (key == "last" ? s.last : key == "before_last" ? s.before_last : s.found_step) =
+            Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+      }
       continue;
     }
     long long value = 0;
@@ -108,6 +114,9 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
     } else if (key == "started") {
       within(0, 1);
       s.started = value != 0;
+    } else if (key == "last_found") {
+      within(0, 1);
+      s.last_found = value != 0;
     } else if (key == "reference_area") {
       within(0, std::numeric_limits<long long>::max());
       s.reference_area = static_cast<std::uint64_t>(value);
