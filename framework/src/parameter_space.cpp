@@ -36,7 +36,7 @@ ParameterSpace ParameterSpace::make(int fingers, const Eigen::Vector3d& pos_lo, 
   ParameterSpace s;
   const int d = kPoseDims + fingers;
   s.names = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
-  for (int f = 0; f < fingers; ++f) s.names.push_back("q" + std::to_string(f + 1) + "_deg");
+  for (int f = 0; f < fingers; ++f) s.names.push_back(joint_name(f + 1));
   s.lower.resize(d);
   s.upper.resize(d);
   s.lower << pos_lo, rot_lo, Eigen::VectorXd::Constant(fingers, joint_lo);
@@ -74,6 +74,15 @@ Eigen::VectorXd parse_parameter_vector(std::string_view text, int expected_dims)
                      std::to_string(expected_dims - kPoseDims) + " joint values in deg)");
   }
   return Eigen::Map<Eigen::VectorXd>(values.data(), expected_dims);
+}
+
+std::string joint_name(int finger) {
+  // Appended rather than "q" + std::to_string(...): GCC 12 warns
+  // (-Wrestrict, a known false positive) on the operator+ of a literal.
+  std::string name = "q";
+  name += std::to_string(finger);
+  name += "_deg";
+  return name;
 }
 
 }  // namespace gtrack

@@ -17,6 +17,10 @@ namespace gtrack {
 
 inline constexpr int kPoseDims = 6;  // x, y, z, rx, ry, rz
 
+// "q<finger>_deg", the name of finger `finger`'s joint (from 1) in every
+// table gtrack reads and writes.
+GTRACK_API std::string joint_name(int finger);
+
 struct ParameterSpace {
   std::vector<std::string> names;  // "x_mm", ..., "rz_deg", "q1_deg", ...
   Eigen::VectorXd lower;

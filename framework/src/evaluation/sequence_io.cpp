@@ -53,9 +53,9 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
   for (const auto& n : names) {
     if (!col.count(n)) throw InputError(file.string() + ":1: missing column '" + n + "'");
   }
-  while (col.count("q" + std::to_string(table.fingers + 1) + "_deg")) ++table.fingers;
+  while (col.count(joint_name(table.fingers + 1))) ++table.fingers;
   if (table.fingers == 0) throw InputError(file.string() + ":1: no joint columns (q1_deg, q2_deg, ...)");
-  for (int f = 0; f < table.fingers; ++f) names.push_back("q" + std::to_string(f + 1) + "_deg");
+  for (int f = 0; f < table.fingers; ++f) names.push_back(joint_name(f + 1));
   std::vector<int> idx;
   for (const auto& n : names) idx.push_back(col[n]);
   const int status_col = col.count("status") ? col["status"] : -1;
