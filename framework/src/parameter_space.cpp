@@ -76,13 +76,6 @@ Eigen::VectorXd parse_parameter_vector(std::string_view text, int expected_dims)
   return Eigen::Map<Eigen::VectorXd>(values.data(), expected_dims);
 }
 
-std::string joint_name(int finger) {
-  // Appended rather than "q" + std::to_string(...): GCC 12 warns
-  // (-Wrestrict, a known false positive) on the operator+ of a literal.
-  std::string name = "q";
-  name += std::to_string(finger);
-  name += "_deg";
-  return name;
-}
+std::string joint_name(int finger) { return "q" + std::to_string(finger) + "_deg"; }
 
 }  // namespace gtrack
