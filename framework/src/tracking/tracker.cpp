@@ -209,8 +209,7 @@ struct Tracker::Impl {
     const auto t1 = std::chrono::steady_clock::now();
     if (observation.empty()) {
       ++lost;
-      before_last.reset();
-      forget_found();
+      forget_motion();
       e.status = TrackStatus::Lost;
       e.hypothesis = last ? *last : fallback_pose();
       show_observation();
@@ -292,11 +291,11 @@ struct Tracker::Impl {
           // occlusion rim, a track gone wrong under an occluder scores well
           // above the truth, and such a requirement kept it there;
           // docs/tracker.md, re-detection.)
-          const bool taken = alternative.total - lt * alternative.temporal <
-                             kRedetectGain * (current.total - lt * current.temporal);
+          const double track_cost = current.total - lt * current.temporal;
+          const double found_cost = alternative.total - lt * alternative.temporal;
+          const bool taken = found_cost < kRedetectGain * track_cost;
           logger().debug("frame {}: re-detection (D without the rim {:.4f} > {}): track {:.4f}, best found {:.4f}: {}",
-                         index, tracked.dice_without_rim, config.tracker.redetect_dice,
-                         current.total - lt * current.temporal, alternative.total - lt * alternative.temporal,
+                         index, tracked.dice_without_rim, config.tracker.redetect_dice, track_cost, found_cost,
                          taken ? "taken" : "the track is kept");
           if (taken) {
             best = found.best;
@@ -343,8 +342,7 @@ struct Tracker::Impl {
         ++lost;
         e.status = TrackStatus::Lost;
         if (!last) last = best;
-        before_last.reset();
-        forget_found();
+        forget_motion();
         e.hypothesis = best;
       } else {
         lost = 0;
@@ -374,7 +372,9 @@ struct Tracker::Impl {
     return e;
   }
 
-  void forget_found() {
+  // No velocity and no found step: the next estimate starts a new track.
+  void forget_motion() {
+    before_last.reset();
     last_found = false;
     found_step.reset();
   }
@@ -514,8 +514,7 @@ Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::o
 
 void Tracker::reset() {
   impl_->last.reset();
-  impl_->before_last.reset();
-  impl_->forget_found();
+  impl_->forget_motion();
   impl_->reference_area = 0;
   impl_->started = false;
   impl_->last_frame = -1;
@@ -566,8 +565,7 @@ void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
     throw Error("set_estimate: expected " + std::to_string(impl_->config.space.dims()) + " parameters");
   }
   impl_->last = hypothesis;
-  impl_->before_last.reset();
-  impl_->forget_found();
+  impl_->forget_motion();
   impl_->started = true;
   impl_->lost = 0;
 }
