@@ -111,8 +111,10 @@ TEST(HydrogelModel, KinematicPenaltyFollowsTheRules) {
   std::vector<double> fine{30, 30, 30, 30, 30, 30};
   EXPECT_EQ(g->kinematic_penalty(fine), 0.0);
   EXPECT_GT(g->kinematic_penalty(ok), 0.0);  // fingers 6 and 1 differ by 50 > 40
-  std::vector<double> beyond{85, 85, 85, 85, 85, 85};  // above joint_max 80
-  EXPECT_NEAR(g->kinematic_penalty(beyond), 6 * 5.0 / 90.0, 1e-12);
+  std::vector<double> beyond{85, 85, 85, 85, 85, 85};  // above joint_max 80, over the range [0, 80]
+  EXPECT_NEAR(g->kinematic_penalty(beyond), 6 * 5.0 / 80.0, 1e-12);
+  std::vector<double> backwards{-4, 0, 0, 0, 0, 0};  // below joint_min 0: a finger folded the wrong way
+  EXPECT_NEAR(g->kinematic_penalty(backwards), 4.0 / 80.0, 1e-12);
 }
 
 TEST(HydrogelModel, ConfigOverridesAreValidated) {

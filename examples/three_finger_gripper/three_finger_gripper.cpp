@@ -17,7 +17,7 @@ gtrack::RadialGripperDefaults three_finger_defaults() {
   d.spec.palm_circumradius_mm = 0.5;  // apothem 0.25 mm
   d.widths_mm = {0.40, 0.34, 0.28, 0.0};
   for (double len : {0.3, 0.25, 0.2}) d.spec.links.push_back({len, 0, 0});
-  d.joint_min_deg = -10;
+  d.joint_min_deg = 0;
   d.joint_max_deg = 80;
   d.max_adjacent_difference_deg = 45;
   d.folded_deg = 50;

@@ -18,7 +18,7 @@ namespace gtrack {
 struct RadialGripperDefaults {
   RadialGripperSpec spec;
   std::vector<double> widths_mm;  // links + 1 values
-  double joint_min_deg = -10;
+  double joint_min_deg = 0;
   double joint_max_deg = 90;
   double max_adjacent_difference_deg = 45;
   double max_adjacent_sum_deg = 1e9;

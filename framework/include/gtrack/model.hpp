@@ -58,7 +58,7 @@ struct GripperGeometry {
   std::string name;
   std::vector<Eigen::Vector2d> palm_mm;  // convex polygon, counter-clockwise
   std::vector<FingerShape> fingers;
-  double joint_min_deg = -10;
+  double joint_min_deg = 0;
   double joint_max_deg = 90;
   CollisionRule collision;
   int symmetry_order = 1;  // rotation by 360/order about model Z maps the model onto itself

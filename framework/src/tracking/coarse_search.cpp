@@ -14,6 +14,8 @@ namespace gtrack::detail {
 
 namespace {
 
+constexpr double kBackwardFoldDeg = 10.0;
+
 struct OutlineScratch {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<ScreenPolygon> polygons;
@@ -83,9 +85,17 @@ Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen:
 CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig& config, CostEvaluator& cost,
                                  std::mt19937_64& rng) {
   CoarseSearchResult result;
-  const ParameterSpace& space = config.space;
   const ArticulatedModel& model = *in.model;
-  const int dims = space.dims();
+  const int dims = config.space.dims();
+  // The refinements may fold the fingers up to kBackwardFoldDeg the wrong
+  // way (K(H) still charges for it). A nearly flat, strongly tilted gripper
+  // is matched on both tilt branches, the mirror one by a slightly reversed
+  // fold (the truth seen through a mirror in the image plane); kept to
+  // forward folds, a refinement on that branch settles on a poor fit. The
+  // result is brought back within the limits, and the tracker's mirror
+  // check then refines the other branch.
+  ParameterSpace space = config.space;
+  space.lower.tail(dims - kPoseDims).array() -= kBackwardFoldDeg;
   const cv::Moments mo = cv::moments(*in.observation, true);
   const double u = mo.m00 > 0 ? mo.m10 / mo.m00 + 0.5 : in.observation->cols * 0.5;
   const double v = mo.m00 > 0 ? mo.m01 / mo.m00 + 0.5 : in.observation->rows * 0.5;
@@ -198,6 +208,16 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
     if (r.best_cost < result.cost) {
       result.cost = r.best_cost;
       result.best = r.best;
+    }
+  }
+  if (result.best.size() == dims) {
+    const Eigen::VectorXd found = result.best;
+    config.space.clamp(result.best);
+    if (result.best != found) {
+      Eigen::VectorXd c;
+      cost.evaluate(result.best, c);
+      result.cost = c[0];
+      result.evaluations += 1;
     }
   }
   return result;

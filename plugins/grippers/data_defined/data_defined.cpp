@@ -82,7 +82,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
       g.collision.adjacent.emplace_back(static_cast<int>(p[0]) - 1, static_cast<int>(p[1]) - 1);
     }
   }
-  g.joint_min_deg = t.number_or("joint_min_deg", -10, Range::closed(-180, 180));
+  g.joint_min_deg = t.number_or("joint_min_deg", 0, Range::closed(-180, 180));
   g.joint_max_deg = t.number_or("joint_max_deg", 90, Range::closed(-180, 180));
   if (!(g.joint_min_deg < g.joint_max_deg)) t.fail("joint_max_deg", "must be greater than joint_min_deg");
   g.collision.max_difference_deg = t.number_or("max_adjacent_difference_deg", 45, Range::positive());

@@ -17,7 +17,7 @@ gtrack::RadialGripperDefaults hydrogel_defaults() {
   d.spec.palm_circumradius_mm = 0.65 / 0.8660254037844386;  // apothem 0.65 mm
   d.widths_mm = {0.60, 0.55, 0.50, 0.45, 0.0};
   for (double len : {0.35, 0.35, 0.35, 0.30}) d.spec.links.push_back({len, 0, 0});
-  d.joint_min_deg = -10;
+  d.joint_min_deg = 0;
   d.joint_max_deg = 80;
   d.max_adjacent_difference_deg = 40;
   d.unfolded_deg = 0;

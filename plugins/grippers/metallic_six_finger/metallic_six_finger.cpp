@@ -18,7 +18,7 @@ gtrack::RadialGripperDefaults metallic_six_defaults() {
   d.spec.palm_circumradius_mm = 0.18 / 0.8660254037844386;
   d.widths_mm = {0.16, 0.13, 0.10, 0.0};
   for (double len : {0.09, 0.09, 0.09}) d.spec.links.push_back({len, 0, 0});
-  d.joint_min_deg = -5;
+  d.joint_min_deg = 0;
   d.joint_max_deg = 90;
   d.max_adjacent_difference_deg = 45;
   d.unfolded_deg = 0;
