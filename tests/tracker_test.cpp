@@ -789,8 +789,12 @@ TEST(Tracker, TheFoldDecidesTheTiltSign) {
     const Eigen::Vector3d n = R.col(2), mirror(-n.x(), -n.y(), n.z());
     const Eigen::Vector3d found =
         gtrack::rotation_from_euler_deg(e.hypothesis[3], e.hypothesis[4], e.hypothesis[5]).col(2);
-    if ((found - n).norm() < (found - mirror).norm()) ++right;
-    else std::printf("pose %d: tilt on the mirror branch, joints %.1f (truth %.1f)\n", i, e.hypothesis.tail(6).mean(), h[6]);
+    if ((found - n).norm() < (found - mirror).norm()) {
+      ++right;
+    } else {
+      std::printf("pose %d: tilt on the mirror branch, joints %.1f (truth %.1f)\n", i, e.hypothesis.tail(6).mean(),
+                  h[6]);
+    }
     EXPECT_GE(e.hypothesis.tail(6).minCoeff(), 0.0) << "pose " << i;
   }
   EXPECT_EQ(right, 12);
