@@ -14,6 +14,7 @@
 #include <random>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
@@ -765,6 +766,25 @@ TEST(Tracker, CoarseSearchFindsRandomPoses) {
   }
 }
 
+// A random pose at 100 mm: (x, y) drawn from `xy`, tilted by a draw of
+// `theta` towards a direction drawn from `angle` and turned about its own
+// axis by another draw of `angle` (R = Rz(a) Rx(theta) Rz(tau)), every
+// joint at one draw of `q`. Returns the pose and R.
+std::pair<Eigen::VectorXd, Eigen::Matrix3d> draw_tilted_pose(std::mt19937_64& rng,
+                                                             std::uniform_real_distribution<double>& xy,
+                                                             std::uniform_real_distribution<double>& theta,
+                                                             std::uniform_real_distribution<double>& angle,
+                                                             std::uniform_real_distribution<double>& q) {
+  const Eigen::Matrix3d R = gtrack::rotation_from_euler_deg(0, 0, angle(rng)) *
+                            gtrack::rotation_from_euler_deg(theta(rng), 0, 0) *
+                            gtrack::rotation_from_euler_deg(0, 0, angle(rng));
+  Eigen::VectorXd h(12);
+  h.head<3>() << xy(rng), xy(rng), 100.0;
+  h.segment<3>(3) = gtrack::euler_deg_from_rotation(R);
+  h.tail(6).setConstant(q(rng));
+  return {h, R};
+}
+
 // Fingers fold one way: with the joints' lower limit at 0 (the plugins'
 // default), a slightly folded, tilted gripper is found on its own tilt
 // branch. Below 0, the tilt's mirror with the fold reversed, (rx, ry, q) ->
@@ -777,13 +797,7 @@ TEST(Tracker, TheFoldDecidesTheTiltSign) {
   std::uniform_real_distribution<double> xy(-0.5, 0.5), theta(15, 30), angle(-180, 180), q(4, 10);
   int right = 0;
   for (int i = 0; i < 12; ++i) {
-    const Eigen::Matrix3d R = gtrack::rotation_from_euler_deg(0, 0, angle(rng)) *
-                              gtrack::rotation_from_euler_deg(theta(rng), 0, 0) *
-                              gtrack::rotation_from_euler_deg(0, 0, angle(rng));
-    Eigen::VectorXd h(12);
-    h.head<3>() << xy(rng), xy(rng), 100.0;
-    h.segment<3>(3) = gtrack::euler_deg_from_rotation(R);
-    h.tail(6).setConstant(q(rng));
+    const auto [h, R] = draw_tilted_pose(rng, xy, theta, angle, q);
     gtrack::Tracker tracker(setup, config);
     const auto e = tracker.process(scene(setup, h, 300 + i), i, 0.0, std::nullopt);
     const Eigen::Vector3d n = R.col(2), mirror(-n.x(), -n.y(), n.z());
@@ -812,13 +826,7 @@ TEST(Tracker, CoarseSearchFindsStronglyTiltedPoses) {
   std::uniform_real_distribution<double> xy(-0.8, 0.8), theta(40, 50), angle(-180, 180), q(0, 60);
   int found = 0;
   for (int i = 0; i < 12; ++i) {
-    const Eigen::Matrix3d R = gtrack::rotation_from_euler_deg(0, 0, angle(rng)) *
-                              gtrack::rotation_from_euler_deg(theta(rng), 0, 0) *
-                              gtrack::rotation_from_euler_deg(0, 0, angle(rng));
-    Eigen::VectorXd h(12);
-    h.head<3>() << xy(rng), xy(rng), 100.0;
-    h.segment<3>(3) = gtrack::euler_deg_from_rotation(R);
-    h.tail(6).setConstant(q(rng));
+    const auto [h, R] = draw_tilted_pose(rng, xy, theta, angle, q);
     gtrack::Tracker tracker(setup, config);
     const auto e = tracker.process(scene(setup, h, 100 + i), i, 0.0, std::nullopt);
     const double truth = tracker.score(h).dice;
