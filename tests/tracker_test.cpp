@@ -477,7 +477,9 @@ TEST(Tracker, OcclusionBudgetHoldsAHalfHiddenGripper) {
     // About half of the model is missing from O, and allowed for.
     EXPECT_GT(e.outside_allowance, 0.3 * full) << "frame " << i;
     EXPECT_LT(e.outside_allowance, 0.7 * full) << "frame " << i;
-    EXPECT_LT(e.terms.dice, 0.05) << "frame " << i;
+    // As good a fit as the truth's (which pays for its rim pixels along the
+    // occluder's edge).
+    EXPECT_LT(e.terms.dice, tracker.score(truth).dice + 0.01) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
     const double joints = (e.hypothesis.tail(6).array() - 30.0).abs().mean();
     EXPECT_LT(joints, 10.0) << "frame " << i << ": " << e.hypothesis.transpose();
@@ -534,7 +536,7 @@ TEST(Tracker, OcclusionBudgetCountsThePartBeyondTheBorder) {
     // All that O lacks of the previous model's whole area is allowed for,
     // the part that was beyond the border included.
     EXPECT_DOUBLE_EQ(e.outside_allowance, whole - static_cast<double>(e.observed_pixels)) << "frame " << i;
-    EXPECT_LT(e.terms.dice, 0.05) << "frame " << i;
+    EXPECT_LT(e.terms.dice, tracker.score(truth).dice + 0.01) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
     const double joints = (e.hypothesis.tail(6).array() - 2.0).abs().mean();
     EXPECT_LT(joints, 10.0) << "frame " << i << ": " << e.hypothesis.transpose();
@@ -690,7 +692,8 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_tolerance, 0.05);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_growth_weight, 0.1);
-  EXPECT_EQ(c.cost.occlusion_rim_px, 1);
+  EXPECT_EQ(c.cost.occlusion_rim_px, 3);
+  EXPECT_DOUBLE_EQ(gtrack::RenderOptions{}.scale, 0.5);  // paper: 0.25
   EXPECT_DOUBLE_EQ(c.tracker.redetect_dice, 0.01);
   EXPECT_TRUE(c.tracker.mirror_check);
   EXPECT_TRUE(c.tracker.coarse_wide_tilts);

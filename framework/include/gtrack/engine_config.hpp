@@ -100,8 +100,9 @@ struct CostWeights {
   // hides a part that continues the gripper, so the true configuration's
   // spill crosses the rim only along the occluder's edge; a model placed
   // loosely around the visible part spills along the whole outline and
-  // pays for it. 0 = the budget alone.
-  int occlusion_rim_px = 1;
+  // pays for it. 0 = the budget alone. In render pixels: 3 at the default
+  // render scale 1/2 is 6 image pixels (docs/tracker.md, "Render scale").
+  int occlusion_rim_px = 3;
 };
 
 struct SearchConfig {

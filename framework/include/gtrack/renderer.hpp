@@ -1,7 +1,7 @@
 // The hot path: N pose hypotheses in, N pairs of pixel counts out (paper 4).
 //
 // A Renderer caches the gripper model once, takes the sensor's Projection and
-// a render scale (paper: 1/4 of the image side), and holds the current
+// a render scale (paper: 1/4 of the image side; default 1/2), and holds the current
 // observation mask at render size. For a batch of hypotheses (one per column,
 // see parameter_space.hpp) it returns, per hypothesis,
 //   intersection = |O & P|  and  rendered = |P|,
@@ -37,7 +37,10 @@ struct PairCounts {
 
 struct RenderOptions {
   std::string backend = "auto";  // "auto" | "gl" | "cpu"
-  double scale = 0.25;           // render size = round(scale * image size)
+  // render size = round(scale * image size). The paper renders at 1/4 of the
+  // image side; at 1/2 the silhouette's sub-pixel shifts from small tilts
+  // and folds reach more pixels (docs/tracker.md, "Render scale").
+  double scale = 0.5;
   int threads = 0;               // cpu backend worker threads; 0 = hardware concurrency
   std::string egl_device;        // gl: device index or "surfaceless"; "" = GTRACK_EGL_DEVICE or auto
 };
