@@ -101,7 +101,8 @@ struct CostWeights {
   // spill crosses the rim only along the occluder's edge; a model placed
   // loosely around the visible part spills along the whole outline and
   // pays for it. 0 = the budget alone. In render pixels: 3 at the default
-  // render scale 1/2 is 6 image pixels (docs/tracker.md, "Render scale").
+  // render scale 1/2 is 6 image pixels (docs/tracker.md, "Render scale and
+  // the rim's width").
   int occlusion_rim_px = 3;
 };
 

@@ -39,7 +39,8 @@ struct RenderOptions {
   std::string backend = "auto";  // "auto" | "gl" | "cpu"
   // render size = round(scale * image size). The paper renders at 1/4 of the
   // image side; at 1/2 the silhouette's sub-pixel shifts from small tilts
-  // and folds reach more pixels (docs/tracker.md, "Render scale").
+  // and folds reach more pixels (docs/tracker.md, "Render scale and the
+  // rim's width").
   double scale = 0.5;
   int threads = 0;               // cpu backend worker threads; 0 = hardware concurrency
   std::string egl_device;        // gl: device index or "surfaceless"; "" = GTRACK_EGL_DEVICE or auto
