@@ -175,10 +175,10 @@ TEST(Tracker, FollowsAMovingFoldingGripper) {
     const Eigen::VectorXd truth = pose(0.3 + 0.03 * i, -0.2, 20 + i, 5 + 2 * i);
     const auto e = tracker.process(scene(setup, truth, i + 1), i, i / 30.0, 22.0 + i);
     EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
-    // N x G per tracked frame, plus the mirror check's N/2 x G/2 (the
-    // gripper is tilted by 10 deg).
+    // N x G per tracked frame, the mirror check's N/2 x G/2 (the gripper
+    // is tilted by 10 deg) and the refinement swarm's N x G.
     EXPECT_FALSE(e.redetected);
-    EXPECT_EQ(e.evaluations, 32u * 25u + 16u * 12u);
+    EXPECT_EQ(e.evaluations, 32u * 25u + 16u * 12u + 32u * 25u);
     EXPECT_LT(e.terms.dice, 0.12) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
   }
@@ -674,6 +674,37 @@ TEST(Tracker, MirrorCheckLeavesTheMirrorTilt) {
   EXPECT_LT(p.hypothesis[3], 0.0) << p.hypothesis.transpose();
 }
 
+// [tracker] refine_spread: the refinement swarm runs last, on the same random
+// stream, so up to it a frame is the unrefined tracker's; it adds N x G
+// evaluations and keeps its result only when that scores lower. A swarm too
+// short to settle (N = 8, G = 3) leaves it something to find.
+TEST(Tracker, TheRefinementSwarmOnlyEverLowersTheCost) {
+  auto setup = make_setup();
+  auto config = gtrack::engine_config(setup);
+  config.pso.particles = 8;
+  config.pso.generations = 3;
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  Eigen::VectorXd start = truth;
+  start[0] += 0.06;
+  start[5] += 4;
+  const cv::Mat img = scene(setup, truth, 11);
+  config.tracker.refine_spread = 0;
+  gtrack::Tracker plain(setup, config);
+  plain.set_estimate(start);
+  const auto a = plain.process(img, 0, 0.0, 26.0);
+  config.tracker.refine_spread = 0.25;
+  gtrack::Tracker refined(setup, config);
+  refined.set_estimate(start);
+  const auto b = refined.process(img, 0, 0.0, 26.0);
+  EXPECT_EQ(b.evaluations, a.evaluations + 8 * 3);
+  EXPECT_LT(b.terms.total, a.terms.total);
+  EXPECT_DOUBLE_EQ(refined.score(b.hypothesis).total, b.terms.total);
+  for (const char* bad : {"-0.5", "\"wide\""}) {
+    auto s = make_setup(std::string("[tracker]\nrefine_spread = ") + bad + "\n");
+    EXPECT_THROW(gtrack::engine_config(s), gtrack::ConfigError) << bad;
+  }
+}
+
 TEST(EngineConfig, PaperDefaults) {
   auto setup = make_setup();
   const auto c = gtrack::engine_config(setup);
@@ -696,6 +727,7 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_DOUBLE_EQ(gtrack::RenderOptions{}.scale, 0.5);  // paper: 0.25
   EXPECT_DOUBLE_EQ(c.tracker.redetect_dice, 0.01);
   EXPECT_TRUE(c.tracker.mirror_check);
+  EXPECT_DOUBLE_EQ(c.tracker.refine_spread, 0.25);  // 0 = no refinement swarm
   EXPECT_TRUE(c.tracker.coarse_wide_tilts);
   // Depth spread: a quarter of the in-plane one (model radius 2 mm).
   EXPECT_NEAR(c.tracker.init_spread[2], 0.25 * c.tracker.init_spread[0], 1e-12);

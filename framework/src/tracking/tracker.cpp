@@ -334,6 +334,21 @@ struct Tracker::Impl {
           terms = score(best);
         }
       }
+      if (config.tracker.refine_spread > 0 && !searching) {
+        // Refinement (not in the paper): a second swarm of N particles and G
+        // generations, started around the result with a fraction of the
+        // spreads. The first swarm's spreads are sized to follow the motion
+        // between frames; in a 12- to 14-parameter space its N x G
+        // evaluations end before they settle, and on most frames with a
+        // large error the truth scores lower than the estimate (gtrack eval
+        // --breakdown after --score-truth). Kept only if it scores lower.
+        const PsoResult r = optimise_with(config.pso, best, stimulus_on, rng, nullptr, config.tracker.refine_spread);
+        logger().debug("frame {}: refinement: result {:.4f}, refined {:.4f}", index, terms.total, r.best_cost);
+        if (r.best_cost < terms.total) {
+          best = r.best;
+          terms = score(best);
+        }
+      }
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
       e.outside_allowance = cost->outside_allowance();  // re-detection may have widened O
       e.observed_pixels = observation.count;
