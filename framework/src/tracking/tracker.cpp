@@ -342,6 +342,8 @@ struct Tracker::Impl {
         // evaluations end before they settle, and on most frames with a
         // large error the truth scores lower than the estimate (gtrack eval
         // --breakdown after --score-truth). Kept only if it scores lower.
+        // Its `mirror_particles` start near the other tilt branch too; a
+        // switch made here is not reported as `mirrored`.
         const PsoResult r = optimise_with(config.pso, best, stimulus_on, rng, nullptr, config.tracker.refine_spread);
         logger().debug("frame {}: refinement: result {:.4f}, refined {:.4f}", index, terms.total, r.best_cost);
         if (r.best_cost < terms.total) {
