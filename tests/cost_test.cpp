@@ -1,6 +1,8 @@
 // Paper eq. (1): D from the renderer's counts, K and S from the plugins, weights.
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "gtrack/cost.hpp"
 
 namespace {
@@ -87,7 +89,11 @@ TEST(Cost, WeightedSumOfTermsInOneBatch) {
   EXPECT_DOUBLE_EQ(t[0].dice, 0.4);
   EXPECT_DOUBLE_EQ(t[0].kinematic, 0.5);
   EXPECT_DOUBLE_EQ(t[0].stimulus, 0.25);
+  // Joints (60, 5): C = ((27.5 / 10)^2 + (27.5 / 10)^2) / 2; (0, 20): C = 1.
+  EXPECT_DOUBLE_EQ(t[0].coherence, 7.5625);
+  // lambda_C is 0 by default (paper): C is reported, not added.
   EXPECT_DOUBLE_EQ(t[0].total, 2.0 * 0.4 + 0.15 * 0.5 + 1.0 * 0.25);
+  EXPECT_DOUBLE_EQ(t[1].coherence, 1.0);
   EXPECT_DOUBLE_EQ(t[1].total, 0.0);
   EXPECT_DOUBLE_EQ(t[2].dice, 1.0);
   Eigen::VectorXd totals;
@@ -282,6 +288,35 @@ TEST(Cost, TemporalTermIsMahalanobisToThePrediction) {
   EXPECT_DOUBLE_EQ(c.total, 0.5 / 8.0);
   eval.clear_prediction();
   EXPECT_DOUBLE_EQ(eval.evaluate_one(x).total, 0.0);
+}
+
+TEST(Cost, CoherenceTermIsTheFingersSpreadAboutTheirMean) {
+  const std::vector<double> alike = {40, 40, 40, 40};
+  EXPECT_DOUBLE_EQ(gtrack::joint_coherence(alike, 10), 0.0);
+  // Mean 40: deviations -20, 0, 0, 20 -> ((2)^2 + (2)^2) / 4 = 2.
+  const std::vector<double> apart = {20, 40, 40, 60};
+  EXPECT_DOUBLE_EQ(gtrack::joint_coherence(apart, 10), 2.0);
+  EXPECT_DOUBLE_EQ(gtrack::joint_coherence(apart, 20), 0.5);
+  // One finger, or no scale: no term.
+  EXPECT_DOUBLE_EQ(gtrack::joint_coherence(std::vector<double>{70}, 10), 0.0);
+  EXPECT_DOUBLE_EQ(gtrack::joint_coherence(apart, 0), 0.0);
+
+  // In the evaluator: lambda_C * C is added, and lambda_C = 0 leaves it out.
+  CountsRenderer r;
+  r.observed = 10;
+  r.counts = {{10, 10}};
+  FixedGripper g;
+  gtrack::CostWeights w;
+  w.coherence = 0.5;
+  w.coherence_sigma_deg = 5;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(8);
+  x[6] = 10;  // joints (10, 20): mean 15, C = (1 + 1) / 2 = 1
+  x[7] = 20;
+  const gtrack::CostTerms c = gtrack::CostEvaluator({&r}, g, nullptr, w).evaluate_one(x);
+  EXPECT_DOUBLE_EQ(c.coherence, 1.0);
+  EXPECT_DOUBLE_EQ(c.total, 0.5);
+  w.coherence = 0;
+  EXPECT_DOUBLE_EQ(gtrack::CostEvaluator({&r}, g, nullptr, w).evaluate_one(x).total, 0.0);
 }
 
 }  // namespace

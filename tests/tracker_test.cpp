@@ -720,6 +720,8 @@ TEST(EngineConfig, PaperDefaults) {
   // Additions on by default (docs/tracker.md); each has a value that turns it off.
   EXPECT_DOUBLE_EQ(c.cost.temporal, 0.001);  // lambda_temporal; 0 = paper
   EXPECT_DOUBLE_EQ(c.cost.temporal_joint_sigma_deg, 3.0);  // 0 = joints left out of T
+  EXPECT_DOUBLE_EQ(c.cost.coherence, 0.0);  // lambda_coherence: paper (the metallic configs set 0.003)
+  EXPECT_DOUBLE_EQ(c.cost.coherence_sigma_deg, 10.0);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_budget, 1.0);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_tolerance, 0.05);
   EXPECT_DOUBLE_EQ(c.cost.occlusion_growth_weight, 0.1);
@@ -752,6 +754,17 @@ TEST(EngineConfig, UnknownTableIsAnError) {
   auto setup = make_setup("[tracer]\nfps = 10\n");
   gtrack::engine_config(setup);
   EXPECT_THROW(gtrack::check_root_keys(setup), gtrack::ConfigError);
+}
+
+TEST(EngineConfig, CoherenceKeysAreReadAndChecked) {
+  const auto c = gtrack::engine_config(make_setup("[cost]\nlambda_coherence = 0.003\ncoherence_sigma_deg = 4\n"));
+  EXPECT_DOUBLE_EQ(c.cost.coherence, 0.003);
+  EXPECT_DOUBLE_EQ(c.cost.coherence_sigma_deg, 4.0);
+  for (const char* bad : {"lambda_coherence = -1", "coherence_sigma_deg = 0", "coherence_sigma_deg = 200",
+                          "lambda_coherence = \"high\""}) {
+    auto s = make_setup(std::string("[cost]\n") + bad + "\n");
+    EXPECT_THROW(gtrack::engine_config(s), gtrack::ConfigError) << bad;
+  }
 }
 
 TEST(EngineConfig, TheRimIsAWholeNumberOfPixels) {

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "gtrack/engine_config.hpp"
@@ -36,6 +37,9 @@ struct CostTerms {
   // D as the occlusion budget alone would score it (the rim's pixels taken
   // as hidden like the others): equal to `dice` without an allowance.
   double dice_without_rim = 1;
+  // C: the fingers' joints' mean squared deviation from their mean, in
+  // units of [cost] coherence_sigma_deg (0 for a gripper of one finger).
+  double coherence = 0;
 };
 
 // D from counts. An empty observation and an empty hypothesis agree
@@ -72,6 +76,10 @@ GTRACK_API double weighted_dice_distance(std::uint64_t intersection, std::uint64
 // wrap_rz. Parameters with sigma_d <= 0 are skipped.
 GTRACK_API double temporal_distance(const Eigen::Ref<const Eigen::VectorXd>& hypothesis,
                                     const Eigen::VectorXd& prediction, const Eigen::VectorXd& sigma, bool wrap_rz);
+
+// The joint-coherence term C: mean over fingers of ((q_i - mean q) /
+// sigma_deg)^2; 0 for fewer than two joints or sigma_deg <= 0.
+GTRACK_API double joint_coherence(std::span<const double> joints, double sigma_deg);
 
 class GTRACK_API CostEvaluator {
  public:

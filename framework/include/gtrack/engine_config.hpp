@@ -76,6 +76,15 @@ struct CostWeights {
   // anywhere there; this ties them to what the stimulus expects. 0 = the
   // joints are left out of T.
   double temporal_joint_sigma_deg = 3.0;
+  // lambda_C: weight of the joint-coherence term C, the mean squared
+  // deviation of the fingers' joints from their mean, in units of
+  // coherence_sigma_deg. The fingers share one stimulus and one material,
+  // so they fold alike; under an occluder the image leaves the hidden
+  // fingers' joints free, and a configuration that bends them apart to fit
+  // what is visible otherwise costs no more than the truth. 0 = paper (the
+  // default); the metallic grippers' configs set 0.003 (docs/tracker.md).
+  double coherence = 0.0;
+  double coherence_sigma_deg = 10.0;
   // occlusion_discount in [0, 1]: when |O| falls below the area of the model
   // rendered at the previous estimate (ratio r < 1), rendered pixels outside
   // O are weighted w = 1 - occlusion_discount * (1 - r) in D (see cost.hpp).

@@ -56,6 +56,16 @@ double temporal_distance(const Eigen::Ref<const Eigen::VectorXd>& hypothesis, co
   return used ? sum / used : 0.0;
 }
 
+double joint_coherence(std::span<const double> joints, double sigma_deg) {
+  if (joints.size() < 2 || !(sigma_deg > 0)) return 0.0;
+  double mean = 0;
+  for (double q : joints) mean += q;
+  mean /= static_cast<double>(joints.size());
+  double sum = 0;
+  for (double q : joints) sum += (q - mean) * (q - mean);
+  return sum / (sigma_deg * sigma_deg) / static_cast<double>(joints.size());
+}
+
 CostEvaluator::CostEvaluator(std::vector<Renderer*> renderers, const Gripper& gripper, const Stimulus* stimulus,
                              CostWeights weights)
     : renderers_(std::move(renderers)), gripper_(&gripper), stimulus_(stimulus), weights_(weights) {
@@ -73,6 +83,7 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
     out[i].kinematic = gripper_->kinematic_penalty(q);
     out[i].stimulus = stimulus_ ? stimulus_->penalty(q) : 0.0;
+    out[i].coherence = joint_coherence(q, weights_.coherence_sigma_deg);
     out[i].temporal = (prediction_.size() > 0 && weights_.temporal > 0)
                           ? temporal_distance(hypotheses.col(i), prediction_, sigma_, wrap_rz_)
                           : 0.0;
@@ -104,7 +115,7 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     t.dice /= views;
     t.dice_without_rim /= views;
     t.total = weights_.dice * t.dice + weights_.kinematic * t.kinematic + weights_.stimulus * t.stimulus +
-              weights_.temporal * t.temporal;
+              weights_.temporal * t.temporal + weights_.coherence * t.coherence;
   }
   evaluations_ += n;
 }

@@ -64,6 +64,8 @@ CostWeights read_cost(const ConfigTable& t) {
   c.temporal = t.number_or("lambda_temporal", c.temporal, Range::non_negative());
   c.temporal_joint_sigma_deg =
       t.number_or("temporal_joint_sigma_deg", c.temporal_joint_sigma_deg, Range::closed(0.0, 180.0));
+  c.coherence = t.number_or("lambda_coherence", c.coherence, Range::non_negative());
+  c.coherence_sigma_deg = t.number_or("coherence_sigma_deg", c.coherence_sigma_deg, {0.0, 180.0, true, false});
   c.occlusion_discount = t.number_or("occlusion_discount", c.occlusion_discount, Range::closed(0.0, 1.0));
   c.occlusion_budget = t.number_or("occlusion_budget", c.occlusion_budget, Range::closed(0.0, 4.0));
   c.occlusion_tolerance = t.number_or("occlusion_tolerance", c.occlusion_tolerance, Range::closed(0.0, 1.0));
