@@ -65,7 +65,7 @@ TEST_P(EndToEnd, SyntheticSequenceIsTracked) {
 }
 
 // One per setup of the paper; the configs are the shipped ones. Measured on
-// these sequences (in-plane): 6.4, 1.1, 2.2 and 17.3 um. A lost track is off
+// these sequences (in-plane): 6.4, 1.3, 1.2 and 17.3 um. A lost track is off
 // by a gripper radius or more (2000, 450, 375 and 2000 um): the bounds sit
 // between, scaled to each setup's pixel size; the ultrasound one is the
 // paper's 2 pixels (180 um).
