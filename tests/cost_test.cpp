@@ -70,6 +70,16 @@ TEST(Cost, EmptyObservationDoesNotDivideByZero) {
   EXPECT_DOUBLE_EQ(gtrack::dice_distance(0, 25, 0), 1.0);
 }
 
+// A hypothesis that covers O exactly (D = 0), so that E is the other terms.
+struct PerfectFit {
+  CountsRenderer r;
+  FixedGripper g;
+  PerfectFit() {
+    r.observed = 10;
+    r.counts = {{10, 10}};
+  }
+};
+
 TEST(Cost, WeightedSumOfTermsInOneBatch) {
   CountsRenderer r;
   r.observed = 60;
@@ -272,13 +282,10 @@ TEST(Cost, TemporalTermIsMahalanobisToThePrediction) {
   EXPECT_GT(gtrack::temporal_distance(h, p, sigma, false), 1000.0 / 7.0);
 
   // In the evaluator: lambda_T * T is added; no prediction, no term.
-  CountsRenderer r;
-  r.observed = 10;
-  r.counts = {{10, 10}};
-  FixedGripper g;
+  PerfectFit fit;
   gtrack::CostWeights w;
   w.temporal = 0.5;
-  gtrack::CostEvaluator eval({&r}, g, nullptr, w);
+  gtrack::CostEvaluator eval({&fit.r}, fit.g, nullptr, w);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(8);
   x[0] = 1;
   EXPECT_DOUBLE_EQ(eval.evaluate_one(x).total, 0.0);
@@ -302,21 +309,18 @@ TEST(Cost, CoherenceTermIsTheFingersSpreadAboutTheirMean) {
   EXPECT_DOUBLE_EQ(gtrack::joint_coherence(apart, 0), 0.0);
 
   // In the evaluator: lambda_C * C is added, and lambda_C = 0 leaves it out.
-  CountsRenderer r;
-  r.observed = 10;
-  r.counts = {{10, 10}};
-  FixedGripper g;
+  PerfectFit fit;
   gtrack::CostWeights w;
   w.coherence = 0.5;
   w.coherence_sigma_deg = 5;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(8);
   x[6] = 10;  // joints (10, 20): mean 15, C = (1 + 1) / 2 = 1
   x[7] = 20;
-  const gtrack::CostTerms c = gtrack::CostEvaluator({&r}, g, nullptr, w).evaluate_one(x);
+  const gtrack::CostTerms c = gtrack::CostEvaluator({&fit.r}, fit.g, nullptr, w).evaluate_one(x);
   EXPECT_DOUBLE_EQ(c.coherence, 1.0);
   EXPECT_DOUBLE_EQ(c.total, 0.5);
   w.coherence = 0;
-  EXPECT_DOUBLE_EQ(gtrack::CostEvaluator({&r}, g, nullptr, w).evaluate_one(x).total, 0.0);
+  EXPECT_DOUBLE_EQ(gtrack::CostEvaluator({&fit.r}, fit.g, nullptr, w).evaluate_one(x).total, 0.0);
 }
 
 }  // namespace
