@@ -115,7 +115,8 @@ std::string estimate_json(const Estimate& e) {
   if (const auto& r = e.reference_terms) {
     j += ",\"reference\":{\"cost\":" + num(r->total, "%.6f") + ",\"D\":" + num(r->dice, "%.6f") +
          ",\"K\":" + num(r->kinematic, "%.6f") + ",\"S\":" + num(r->stimulus, "%.6f") +
-         ",\"T\":" + num(r->temporal, "%.6f") + ",\"C\":" + num(r->coherence, "%.6f") + ",\"rendered_pixels\":" + std::to_string(r->rendered) +
+         ",\"T\":" + num(r->temporal, "%.6f") + ",\"C\":" + num(r->coherence, "%.6f") +
+         ",\"rendered_pixels\":" + std::to_string(r->rendered) +
          ",\"overlap_pixels\":" + std::to_string(r->overlap) + ",\"rim_pixels\":" + std::to_string(r->rim) + "}";
   }
   j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") + "}";
