@@ -141,9 +141,15 @@ struct TrackerConfig {
   bool mirror_check = true;              // refine the tilt mirror of a tilted (> 3 deg) result, keep the lower
   int mirror_particles = 2;              // particles started at the mirror tilt (-rx, -ry); 0 = paper's plain init
   // Refinement: after the swarm (and any re-detection or mirror check), a
-  // second swarm of [pso] N and G starts around the result with the spreads
-  // times this; the lower of the two is kept. 0 = none (the paper's tracker).
+  // second search of [pso] N samples and G generations starts around the
+  // result with the spreads times this; the lower of the two is kept.
+  // 0 = none (the paper's tracker).
   double refine_spread = 0.25;
+  // The refinement's optimiser: "cmaes" (CMA-ES, its first samples with a
+  // standard deviation of refine_spread / sqrt(3) spreads) or "pso" (a swarm
+  // initialised uniformly within refine_spread spreads, the previous
+  // release's refinement).
+  std::string refine_optimizer = "cmaes";
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4
 };

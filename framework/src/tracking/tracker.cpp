@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "coarse_search.hpp"
+#include "gtrack/cmaes.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 
@@ -344,7 +345,9 @@ struct Tracker::Impl {
         // --breakdown after --score-truth). Kept only if it scores lower.
         // Its `mirror_particles` start near the other tilt branch too; a
         // switch made here is not reported as `mirrored`.
-        const PsoResult r = optimise_with(config.pso, best, stimulus_on, rng, nullptr, config.tracker.refine_spread);
+        const PsoResult r = config.tracker.refine_optimizer == "cmaes"
+                                ? refine_cmaes(best, stimulus_on, rng)
+                                : optimise_with(config.pso, best, stimulus_on, rng, nullptr, config.tracker.refine_spread);
         logger().debug("frame {}: refinement: result {:.4f}, refined {:.4f}", index, terms.total, r.best_cost);
         if (r.best_cost < terms.total) {
           best = r.best;
@@ -480,22 +483,42 @@ struct Tracker::Impl {
     return optimise_with(config.pso, from, stimulus_on, rng, prediction).best;
   }
 
-  PsoResult optimise_with(const PsoConfig& pso_config, const Eigen::VectorXd& from, bool stimulus_on,
-                          std::mt19937_64& rng, const Eigen::VectorXd* prediction = nullptr,
-                          double spread_scale = 1.0) {
-    const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
-    const Eigen::VectorXd s = spread() * spread_scale;
+  // The refinement by CMA-ES (docs/tracker.md, "The refinement"): N samples
+  // a generation for G generations, from the result with joints the
+  // stimulus allows now, the first samples' standard deviation that of a
+  // uniform draw within refine_spread spreads.
+  PsoResult refine_cmaes(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng) {
+    CmaesOptions options;
+    options.population = std::max(4, config.pso.particles);
+    options.generations = config.pso.generations;
+    options.step = config.tracker.refine_spread / std::sqrt(3.0);
+    return cmaes_minimize(
+        start_from(from, stimulus_on), spread(), config.space, options,
+        [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
+  }
+
+  // `from` with its joints brought into the range the stimulus allows now,
+  // inside the box: where every search of a frame starts.
+  Eigen::VectorXd start_from(const Eigen::VectorXd& from, bool stimulus_on) const {
     Eigen::VectorXd start = from;
     if (const auto allowed = stimulus_joints(stimulus_on)) {
-      // The swarm starts from joints the stimulus allows now: with a
-      // response time the allowed range moves with the fold, and a previous
-      // estimate left outside it would otherwise have to be walked back by
-      // the penalty alone.
+      // With a response time the allowed range moves with the fold, and a
+      // previous estimate left outside it would otherwise have to be walked
+      // back by the penalty alone.
       for (Eigen::Index d = kPoseDims; d < start.size(); ++d) {
         start[d] = std::clamp(start[d], allowed->first, allowed->second);
       }
     }
     config.space.clamp(start);
+    return start;
+  }
+
+  PsoResult optimise_with(const PsoConfig& pso_config, const Eigen::VectorXd& from, bool stimulus_on,
+                          std::mt19937_64& rng, const Eigen::VectorXd* prediction = nullptr,
+                          double spread_scale = 1.0) {
+    const double fold = stimulus_on ? setup.stimulus->fold_fraction() : 0.5;
+    const Eigen::VectorXd s = spread() * spread_scale;
+    const Eigen::VectorXd start = start_from(from, stimulus_on);
     Eigen::MatrixXd init = biased_initial_swarm(start, s, fold, pso_config.particles, config.space, rng);
     // Seen along the optical axis, a flat gripper tilted by (rx, ry) and by
     // (-rx, -ry) casts the same silhouette. The last few particles explore
