@@ -336,15 +336,16 @@ struct Tracker::Impl {
         }
       }
       if (config.tracker.refine_spread > 0 && !searching) {
-        // Refinement (not in the paper): a second swarm of N particles and G
+        // Refinement (not in the paper): a second search of N samples and G
         // generations, started around the result with a fraction of the
-        // spreads. The first swarm's spreads are sized to follow the motion
-        // between frames; in a 12- to 14-parameter space its N x G
-        // evaluations end before they settle, and on most frames with a
-        // large error the truth scores lower than the estimate (gtrack eval
-        // --breakdown after --score-truth). Kept only if it scores lower.
-        // Its `mirror_particles` start near the other tilt branch too; a
-        // switch made here is not reported as `mirrored`.
+        // spreads; CMA-ES by default, the previous release's swarm with
+        // refine_optimizer = "pso". The first swarm's spreads are sized to
+        // follow the motion between frames; in a 12- to 14-parameter space
+        // its N x G evaluations end before they settle, and on most frames
+        // with a large error the truth scores lower than the estimate
+        // (gtrack eval --breakdown after --score-truth). Kept only if it
+        // scores lower. The swarm's `mirror_particles` start near the other
+        // tilt branch too; a switch made here is not reported as `mirrored`.
         const PsoResult r = config.tracker.refine_optimizer == "cmaes"
                                 ? refine_cmaes(best, stimulus_on, rng)
                                 : optimise_with(config.pso, best, stimulus_on, rng, nullptr, config.tracker.refine_spread);
