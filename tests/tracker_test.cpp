@@ -18,6 +18,7 @@
 
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/model.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/tracker_state.hpp"
 
@@ -689,6 +690,65 @@ TEST(Tracker, MirrorCheckLeavesTheMirrorTilt) {
   const auto p = plain.process(img, 0, 0.0, 26.0);
   EXPECT_FALSE(p.mirrored);
   EXPECT_LT(p.hypothesis[3], 0.0) << p.hypothesis.transpose();
+}
+
+// The turned tilt of re-detection's searches: the tilt (rx, ry) turned in
+// its plane, the rest of the configuration unchanged; 180 deg is the mirror.
+TEST(Model, TiltTurnedKeepsTheTiltAndTheRest) {
+  Eigen::VectorXd h = pose(0.3, -0.2, 20, 40);
+  h[3] = 30;
+  h[4] = 10;
+  const Eigen::VectorXd m = gtrack::tilt_turned(h, 180);
+  EXPECT_NEAR(m[3], -30, 1e-9);
+  EXPECT_NEAR(m[4], -10, 1e-9);
+  Eigen::VectorXd t = h;
+  for (int k = 0; k < 6; ++k) {
+    t = gtrack::tilt_turned(t, 60);
+    EXPECT_NEAR(std::hypot(t[3], t[4]), std::hypot(30.0, 10.0), 1e-9);
+    EXPECT_EQ(t.segment(5, 7), h.segment(5, 7));
+    EXPECT_EQ(t.head<3>(), h.head<3>());
+  }
+  EXPECT_NEAR((t - h).norm(), 0.0, 1e-9);
+  const Eigen::VectorXd q = gtrack::tilt_turned(h, 90);
+  EXPECT_NEAR(q[3], -10, 1e-9);
+  EXPECT_NEAR(q[4], 30, 1e-9);
+}
+
+// [tracker] redetect_tilt_directions: re-detection also searches from the
+// track with its tilt turned by 60, 120, ... 300 deg, each search a short
+// CMA-ES (N/2 samples, G/3 generations), and keeps what scores lowest. Here
+// the track's tilt points 120 deg away from the truth's. (In plain view the
+// coarse search finds this gripper too; the searches matter under large
+// occluders, docs/RESULTS.md.)
+TEST(Tracker, RedetectionTriesTheTiltTurned) {
+  auto setup = make_setup();
+  auto config = gtrack::engine_config(setup);
+  EXPECT_EQ(config.tracker.redetect_tilt_directions, 0);  // the engine's default: none
+  config.tracker.mirror_check = false;
+  config.tracker.refine_spread = 0;
+  Eigen::VectorXd truth = pose(0.3, -0.2, 20, 40);
+  truth[3] = 45;
+  truth[4] = 0;
+  const Eigen::VectorXd wrong = gtrack::tilt_turned(truth, 120);
+  const cv::Mat img = scene(setup, truth, 6);  // 26 C: in the transition, 40 deg is allowed
+  gtrack::Estimate e[2];
+  for (int directions : {0, 6}) {
+    config.tracker.redetect_tilt_directions = directions;
+    gtrack::Tracker tracker(setup, config);
+    tracker.set_estimate(wrong);
+    e[directions > 0] = tracker.process(img, 0, 0.0, 26.0);
+  }
+  // Up to re-detection the two frames are the same; then five searches of
+  // 16 x 8 more, whose best is kept only if it scores lower.
+  EXPECT_EQ(e[1].evaluations, e[0].evaluations + 5 * 16 * 8);
+  EXPECT_TRUE(e[1].redetected);
+  EXPECT_LE(e[1].terms.total, e[0].terms.total);
+  EXPECT_LT(std::hypot(e[1].hypothesis[3] - truth[3], e[1].hypothesis[4] - truth[4]), 12.0)
+      << e[1].hypothesis.transpose();
+  for (const char* bad : {"-1", "37", "2.5"}) {
+    const std::string m = engine_config_error(std::string("[tracker]\nredetect_tilt_directions = ") + bad + "\n");
+    EXPECT_NE(m.find("redetect_tilt_directions"), std::string::npos) << m;
+  }
 }
 
 // [tracker] refine_spread: the refinement swarm runs last, on the same random

@@ -40,6 +40,14 @@ Eigen::Vector3d euler_deg_from_rotation(const Eigen::Matrix3d& r) {
   return Eigen::Vector3d(rx, ry, rz) / kDeg;
 }
 
+Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg) {
+  const double c = std::cos(deg * kDeg), s = std::sin(deg * kDeg);
+  Eigen::VectorXd t = h;
+  t[3] = c * h[3] - s * h[4];
+  t[4] = s * h[3] + c * h[4];
+  return t;
+}
+
 ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) {
   const auto& G = geometry_;
   if (G.palm_mm.size() < 3) throw Error("gripper '" + G.name + "': the palm polygon needs at least 3 points");

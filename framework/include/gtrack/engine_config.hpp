@@ -138,6 +138,10 @@ struct TrackerConfig {
   // settled in a wrong basin back once the gripper is clearly seen.
   // 1 = never (the paper's tracker).
   double redetect_dice = 0.01;
+  // Re-detection's tilt directions: n >= 2 adds n - 1 short CMA-ES searches
+  // started from the track with its tilt (rx, ry) turned by 360/n, 2 x 360/n,
+  // ... degrees (docs/tracker.md, re-detection); 0 or 1 = none.
+  int redetect_tilt_directions = 0;
   bool mirror_check = true;              // refine the tilt mirror of a tilted (> 3 deg) result, keep the lower
   int mirror_particles = 2;              // particles started at the mirror tilt (-rx, -ry); 0 = paper's plain init
   // Refinement: after the swarm (and any re-detection or mirror check), a

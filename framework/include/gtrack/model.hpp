@@ -117,6 +117,11 @@ GTRACK_API Eigen::Matrix3d rotation_from_euler_deg(double rx, double ry, double 
 // Inverse of the above (rx, ry, rz in degrees).
 GTRACK_API Eigen::Vector3d euler_deg_from_rotation(const Eigen::Matrix3d& r);
 
+// h (x, y, z, rx, ry, rz, joints...) with its tilt (rx, ry) turned by `deg`
+// in the (rx, ry) plane, the rest unchanged: as much tilt, in another
+// direction; 180 is the tilt mirror (-rx, -ry).
+GTRACK_API Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg);
+
 // A regular-polygon gripper with identical fingers on every palm edge: the
 // shape of all three grippers of the paper.
 struct RadialGripperSpec {

@@ -137,6 +137,8 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.coarse_wide_tilts = t.boolean_or("coarse_wide_tilts", c.coarse_wide_tilts);
   c.mirror_check = t.boolean_or("mirror_check", c.mirror_check);
   c.redetect_dice = t.number_or("redetect_dice", c.redetect_dice, Range::closed(0.0, 1.0));
+  c.redetect_tilt_directions = static_cast<int>(
+      t.integer_or("redetect_tilt_directions", c.redetect_tilt_directions, Range::closed(0, 36)));
   c.mirror_particles = static_cast<int>(t.integer_or("mirror_particles", c.mirror_particles, Range::closed(0, 1 << 16)));
   c.refine_spread = t.number_or("refine_spread", c.refine_spread, Range::closed(0.0, 10.0));
   c.refine_optimizer = t.choice_or("refine_optimizer", c.refine_optimizer, {"cmaes", "pso"});

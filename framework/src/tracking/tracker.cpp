@@ -280,6 +280,19 @@ struct Tracker::Impl {
               found.cost = wide.best_cost;
             }
           }
+          // Tilt directions: under a large occluder, a folded gripper
+          // tilted one way and one tilted as much another way can show the
+          // same visible part, and a track on the wrong direction stays
+          // there: every search of the frame starts from it. Short CMA-ES
+          // runs start from the track with its tilt turned.
+          const int directions = config.tracker.redetect_tilt_directions;
+          for (int k = 1; k < directions; ++k) {
+            const PsoResult turned = search_turned_tilt(best, 360.0 * k / directions, stimulus_on, rng);
+            if (turned.best_cost < found.cost) {
+              found.best = turned.best;
+              found.cost = turned.best_cost;
+            }
+          }
           if (predicting) set_temporal_prediction(*prediction);
           const CostTerms alternative = score(found.best);
           const double lt = config.cost.temporal;
@@ -489,13 +502,30 @@ struct Tracker::Impl {
   // stimulus allows now, the first samples' standard deviation that of a
   // uniform draw within refine_spread spreads.
   PsoResult refine_cmaes(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng) {
+    return cmaes_from(start_from(from, stimulus_on), config.tracker.refine_spread / std::sqrt(3.0),
+                      std::max(4, config.pso.particles), config.pso.generations, rng);
+  }
+
+  // A CMA-ES from `start` (inside the box) over the spreads, each generation
+  // one batch of the cost.
+  PsoResult cmaes_from(const Eigen::VectorXd& start, double step, int population, int generations,
+                       std::mt19937_64& rng) {
     CmaesOptions options;
-    options.population = std::max(4, config.pso.particles);
-    options.generations = config.pso.generations;
-    options.step = config.tracker.refine_spread / std::sqrt(3.0);
+    options.population = population;
+    options.generations = generations;
+    options.step = step;
     return cmaes_minimize(
-        start_from(from, stimulus_on), spread(), config.space, options,
+        start, spread(), config.space, options,
         [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
+  }
+
+  // Re-detection's search from `from` with its tilt (rx, ry) turned by
+  // `turn_deg` about the line of sight, the rest unchanged: a CMA-ES of N/2
+  // samples and G/3 generations, its first samples' standard deviation that
+  // of a uniform draw within one spread.
+  PsoResult search_turned_tilt(const Eigen::VectorXd& from, double turn_deg, bool stimulus_on, std::mt19937_64& rng) {
+    return cmaes_from(start_from(tilt_turned(from, turn_deg), stimulus_on), 1.0 / std::sqrt(3.0),
+                      std::max(4, config.pso.particles / 2), std::max(2, config.pso.generations / 3), rng);
   }
 
   // `from` with its joints brought into the range the stimulus allows now,
