@@ -273,13 +273,13 @@ struct Tracker::Impl {
           const bool predicting = prediction && config.cost.temporal > 0;
           if (predicting) cost->clear_prediction();
           auto found = coarse(stimulus_on, rng);
-          {
-            const PsoResult wide = optimise_with(config.pso, best, stimulus_on, rng, nullptr, kWideSpread);
-            if (wide.best_cost < found.cost) {
-              found.best = wide.best;
-              found.cost = wide.best_cost;
+          const auto keep_lower = [&found](const PsoResult& r) {
+            if (r.best_cost < found.cost) {
+              found.best = r.best;
+              found.cost = r.best_cost;
             }
-          }
+          };
+          keep_lower(optimise_with(config.pso, best, stimulus_on, rng, nullptr, kWideSpread));
           // Tilt directions: under a large occluder, a folded gripper
           // tilted one way and one tilted as much another way can show the
           // same visible part, and a track on the wrong direction stays
@@ -287,11 +287,7 @@ struct Tracker::Impl {
           // runs start from the track with its tilt turned.
           const int directions = config.tracker.redetect_tilt_directions;
           for (int k = 1; k < directions; ++k) {
-            const PsoResult turned = search_turned_tilt(best, 360.0 * k / directions, stimulus_on, rng);
-            if (turned.best_cost < found.cost) {
-              found.best = turned.best;
-              found.cost = turned.best_cost;
-            }
+            keep_lower(search_turned_tilt(best, 360.0 * k / directions, stimulus_on, rng));
           }
           if (predicting) set_temporal_prediction(*prediction);
           const CostTerms alternative = score(found.best);
@@ -351,7 +347,7 @@ struct Tracker::Impl {
       if (config.tracker.refine_spread > 0 && !searching) {
         // Refinement (not in the paper): a second search of N samples and G
         // generations, started around the result with a fraction of the
-        // spreads; CMA-ES by default, the previous release's swarm with
+        // spreads; CMA-ES by default, an earlier release's swarm with
         // refine_optimizer = "pso". The first swarm's spreads are sized to
         // follow the motion between frames; in a 12- to 14-parameter space
         // its N x G evaluations end before they settle, and on most frames
