@@ -132,6 +132,10 @@ struct TrackerConfig {
   int coarse_rz_steps = 12;              // rz hypotheses over one symmetry period
   int coarse_candidates = 4;             // best coarse hypotheses refined by a PSO each
   bool coarse_wide_tilts = true;         // the coarse grid also tries 50 deg tilts (x, y, diagonals)
+  // Where O touches the image's border, each coarse grid point is also tried
+  // moved out across it by 1..n steps of 0.3 model radii (a gripper coming
+  // into view shows a sliver of itself; docs/tracker.md). 0 = off.
+  int coarse_border_steps = 3;
   // Re-detection: when the tracked estimate's D is above this, the coarse
   // search and a wide swarm also run on the frame, and their result replaces
   // the track on a clear gain (docs/tracker.md); it pulls a track that

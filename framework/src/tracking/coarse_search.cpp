@@ -15,6 +15,7 @@ namespace gtrack::detail {
 namespace {
 
 constexpr double kBackwardFoldDeg = 10.0;
+constexpr double kBorderStepRadii = 0.3;  // the coarse grid's step out across a border
 
 struct OutlineScratch {
   std::vector<Eigen::Vector3d> vertices;
@@ -64,6 +65,17 @@ std::optional<Eigen::Vector2d> outline_centroid(const ArticulatedModel& model, c
   }
   if (area <= 0) return std::nullopt;
   return sum / area;
+}
+
+// The outward direction across the image's borders that `mask` touches,
+// each border weighted by the mask's pixels on it; zero when it touches none.
+Eigen::Vector2d border_outward(const cv::Mat& mask) {
+  Eigen::Vector2d out(0, 0);
+  out.y() -= cv::countNonZero(mask.row(0));
+  out.y() += cv::countNonZero(mask.row(mask.rows - 1));
+  out.x() -= cv::countNonZero(mask.col(0));
+  out.x() += cv::countNonZero(mask.col(mask.cols - 1));
+  return out.norm() > 0 ? Eigen::Vector2d(out.normalized()) : out;
 }
 
 }  // namespace
@@ -181,6 +193,48 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
       if (centred_scores[i] < scores[i]) {
         grid.col(i) = centred.col(i);
         scores[i] = centred_scores[i];
+      }
+    }
+
+    // Coming into view (or leaving it), the gripper shows a sliver: the
+    // centred grid point, which shows about half of its outline, covers far
+    // more than O. Where O touches the image's border, each grid point is
+    // also tried moved out across it by 1..n steps of 0.3 model radii, and
+    // centred again along the border only (one more batch of n per point);
+    // each point keeps its best place.
+    const int steps = tc.coarse_border_steps;
+    const Eigen::Vector2d outward = border_outward(*in.observation);
+    if (steps > 0 && outward.norm() > 0) {
+      const Eigen::Vector2d along(-outward.y(), outward.x());
+      const Eigen::Vector2d c0 = render::dehomogenise(render::project(in.render_projection, centre));
+      const Eigen::Vector2d c1 = render::dehomogenise(
+          render::project(in.render_projection, centre + Eigen::Vector3d(model.radius_mm(), 0, 0)));
+      const double step = kBorderStepRadii * (c1 - c0).norm();
+      Eigen::MatrixXd moved(dims, grid.cols() * steps);
+      for (Eigen::Index i = 0; i < grid.cols(); ++i) {
+        for (int k = 0; k < steps; ++k) {
+          Eigen::VectorXd h = grid.col(i);
+          Eigen::Vector2d p =
+              render::dehomogenise(render::project(in.render_projection, h.head<3>())) + outward * step * (k + 1);
+          h.head<3>() = lift_pixel(in.render_projection, p[0], p[1], h.head<3>());
+          if (const auto c = outline_centroid(model, in.render_projection, image, h, scratch)) {
+            p += along * (Eigen::Vector2d(u, v) - *c).dot(along);
+            h.head<3>() = lift_pixel(in.render_projection, p[0], p[1], h.head<3>());
+          }
+          space.clamp(h);
+          moved.col(i * steps + k) = h;
+        }
+      }
+      Eigen::VectorXd moved_scores;
+      cost.evaluate(moved, moved_scores);
+      result.evaluations += static_cast<std::uint64_t>(moved.cols());
+      for (Eigen::Index i = 0; i < grid.cols(); ++i) {
+        for (int k = 0; k < steps; ++k) {
+          if (moved_scores[i * steps + k] < scores[i]) {
+            grid.col(i) = moved.col(i * steps + k);
+            scores[i] = moved_scores[i * steps + k];
+          }
+        }
       }
     }
   }

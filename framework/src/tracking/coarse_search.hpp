@@ -5,8 +5,10 @@
 // (the point of the centroid's line of sight nearest the nominal position);
 // a grid of hypotheses there — rz over one symmetry period, five tilts (13
 // with [tracker] coarse_wide_tilts), four joint values within what the
-// stimulus allows — is scored in batches, and the best few seed one PSO each
-// with wide spreads. The best result wins.
+// stimulus allows — is scored in batches, each point also tried with its
+// visible outline centred on O's and, where O touches the image's border,
+// moved out across it ([tracker] coarse_border_steps); the best few seed
+// one PSO each with wide spreads. The best result wins.
 #pragma once
 
 #include <Eigen/Core>

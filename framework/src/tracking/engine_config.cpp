@@ -135,6 +135,8 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.coarse_rz_steps = static_cast<int>(t.integer_or("coarse_rz_steps", c.coarse_rz_steps, Range::closed(1, 360)));
   c.coarse_candidates = static_cast<int>(t.integer_or("coarse_candidates", c.coarse_candidates, Range::closed(1, 64)));
   c.coarse_wide_tilts = t.boolean_or("coarse_wide_tilts", c.coarse_wide_tilts);
+  c.coarse_border_steps =
+      static_cast<int>(t.integer_or("coarse_border_steps", c.coarse_border_steps, Range::closed(0, 8)));
   c.mirror_check = t.boolean_or("mirror_check", c.mirror_check);
   c.redetect_dice = t.number_or("redetect_dice", c.redetect_dice, Range::closed(0.0, 1.0));
   c.redetect_tilt_directions = static_cast<int>(
