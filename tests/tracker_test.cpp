@@ -968,15 +968,21 @@ TEST(Tracker, CoarseSearchFindsStronglyTiltedPoses) {
   EXPECT_GE(found, 11);
 }
 
+// The test config with a search box of +-6 mm in x and y, so that a
+// gripper may lie partly or mostly beyond the image's +-4 mm.
+std::string config_with_wide_box() {
+  std::string text = kConfig;
+  const std::string box = "position_min_mm = [-3.0, -3.0, 98.0]\nposition_max_mm = [3.0, 3.0, 102.0]";
+  text.replace(text.find(box), box.size(), "position_min_mm = [-6.0, -6.0, 98.0]\nposition_max_mm = [6.0, 6.0, 102.0]");
+  return text;
+}
+
 // The coarse search on a gripper that is partly out of the image (its palm
 // centre 0.2 mm inside a border, about 45 % of it outside; any tilt up to
 // 30 deg, turn and fold): the observed centroid is that of the visible part,
 // and a grid point is placed so that its own visible part is centred there.
 TEST(Tracker, CoarseSearchFindsGrippersAtTheBorder) {
-  std::string config_text = kConfig;
-  const std::string box = "position_min_mm = [-3.0, -3.0, 98.0]\nposition_max_mm = [3.0, 3.0, 102.0]";
-  config_text.replace(config_text.find(box), box.size(),
-                      "position_min_mm = [-6.0, -6.0, 98.0]\nposition_max_mm = [6.0, 6.0, 102.0]");
+  const std::string config_text = config_with_wide_box();
   auto setup = gtrack::load_setup(gtrack::ConfigTable::parse(config_text, "<test>"), {});
   const auto config = gtrack::engine_config(setup);
   std::mt19937_64 rng(11);
@@ -1008,10 +1014,7 @@ TEST(Tracker, CoarseSearchFindsGrippersAtTheBorder) {
 // grid point shows about half of its outline, far more than O, and the
 // grid's points moved out across the border find it.
 TEST(Tracker, CoarseSearchFindsGrippersComingIntoView) {
-  std::string config_text = kConfig;
-  const std::string box = "position_min_mm = [-3.0, -3.0, 98.0]\nposition_max_mm = [3.0, 3.0, 102.0]";
-  config_text.replace(config_text.find(box), box.size(),
-                      "position_min_mm = [-6.0, -6.0, 98.0]\nposition_max_mm = [6.0, 6.0, 102.0]");
+  const std::string config_text = config_with_wide_box();
   const auto count_found = [&](int steps) {
     auto setup = gtrack::load_setup(
         gtrack::ConfigTable::parse(config_text + "\n[tracker]\ncoarse_border_steps = " + std::to_string(steps) + "\n",

@@ -78,6 +78,25 @@ Eigen::Vector2d border_outward(const cv::Mat& mask) {
   return out.norm() > 0 ? Eigen::Vector2d(out.normalized()) : out;
 }
 
+// Scores `tried` in one batch, `per_point` columns for each column of
+// `grid` in order; each grid point takes the lowest of its tried places
+// where that scores below it.
+void keep_better_places(Eigen::MatrixXd& grid, Eigen::VectorXd& scores, const Eigen::MatrixXd& tried, int per_point,
+                        CostEvaluator& cost, std::uint64_t& evaluations) {
+  Eigen::VectorXd tried_scores;
+  cost.evaluate(tried, tried_scores);
+  evaluations += static_cast<std::uint64_t>(tried.cols());
+  for (Eigen::Index i = 0; i < grid.cols(); ++i) {
+    for (int k = 0; k < per_point; ++k) {
+      const Eigen::Index j = i * per_point + k;
+      if (tried_scores[j] < scores[i]) {
+        grid.col(i) = tried.col(j);
+        scores[i] = tried_scores[j];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen::Vector3d& near) {
@@ -186,15 +205,7 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
         if (!scratch.cut) break;
       }
     }
-    Eigen::VectorXd centred_scores;
-    cost.evaluate(centred, centred_scores);
-    result.evaluations += static_cast<std::uint64_t>(centred.cols());
-    for (Eigen::Index i = 0; i < grid.cols(); ++i) {
-      if (centred_scores[i] < scores[i]) {
-        grid.col(i) = centred.col(i);
-        scores[i] = centred_scores[i];
-      }
-    }
+    keep_better_places(grid, scores, centred, 1, cost, result.evaluations);
 
     // Coming into view (or leaving it), the gripper shows a sliver: the
     // centred grid point, which shows about half of its outline, covers far
@@ -203,8 +214,8 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
     // centred again along the border only (one more batch of n per point);
     // each point keeps its best place.
     const int steps = tc.coarse_border_steps;
-    const Eigen::Vector2d outward = border_outward(*in.observation);
-    if (steps > 0 && outward.norm() > 0) {
+    const Eigen::Vector2d outward = steps > 0 ? border_outward(*in.observation) : Eigen::Vector2d::Zero();
+    if (outward.norm() > 0) {
       const Eigen::Vector2d along(-outward.y(), outward.x());
       const Eigen::Vector2d c0 = render::dehomogenise(render::project(in.render_projection, centre));
       const Eigen::Vector2d c1 = render::dehomogenise(
@@ -225,17 +236,7 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
           moved.col(i * steps + k) = h;
         }
       }
-      Eigen::VectorXd moved_scores;
-      cost.evaluate(moved, moved_scores);
-      result.evaluations += static_cast<std::uint64_t>(moved.cols());
-      for (Eigen::Index i = 0; i < grid.cols(); ++i) {
-        for (int k = 0; k < steps; ++k) {
-          if (moved_scores[i * steps + k] < scores[i]) {
-            grid.col(i) = moved.col(i * steps + k);
-            scores[i] = moved_scores[i * steps + k];
-          }
-        }
-      }
+      keep_better_places(grid, scores, moved, steps, cost, result.evaluations);
     }
   }
 
