@@ -190,9 +190,11 @@ TEST(Tracker, FollowsAMovingFoldingGripper) {
     const auto e = tracker.process(scene(setup, truth, i + 1), i, i / 30.0, 22.0 + i);
     EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
     // N x G per tracked frame, the mirror check's N/2 x G/2 (the gripper
-    // is tilted by 10 deg) and the refinement swarm's N x G.
+    // is tilted by 10 deg), the refinement's N x G and the unseen-finger
+    // check's 6 (one a finger), plus one when it fills some in.
     EXPECT_FALSE(e.redetected);
-    EXPECT_EQ(e.evaluations, 32u * 25u + 16u * 12u + 32u * 25u);
+    EXPECT_GE(e.evaluations, 32u * 25u + 16u * 12u + 32u * 25u + 6u);
+    EXPECT_LE(e.evaluations, 32u * 25u + 16u * 12u + 32u * 25u + 7u);
     EXPECT_LT(e.terms.dice, 0.12) << "frame " << i;
     EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.05) << "frame " << i;
   }
@@ -785,6 +787,68 @@ TEST(Tracker, TheRefinementOnlyEverLowersTheCost) {
   }
 }
 
+// [tracker] unseen_joint_tolerance: under an occluder that hides the left
+// half of the gripper, the fingers there do not change what is rendered
+// inside O, and the track leaves their joints wherever it started them. The
+// estimate reports them at the seen fingers' mean fold; the pose, the seen
+// fingers and the track's own state stay the search's result.
+TEST(Tracker, UnseenFingersTakeTheSeenFingersFold) {
+  auto setup = make_setup();
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  Eigen::VectorXd start = truth;
+  start.tail(6) << 10, 50, 10, 50, 10, 50;  // every finger 20 deg off
+  const auto joint_error = [&](const Eigen::VectorXd& h) { return (h.tail(6).array() - 30.0).abs().mean(); };
+  const auto track = [&](double tolerance) {
+    auto config = gtrack::engine_config(setup);
+    config.tracker.unseen_joint_tolerance = tolerance;
+    auto tracker = std::make_unique<gtrack::Tracker>(setup, config);
+    tracker->set_estimate(start);
+    gtrack::Estimate e;
+    // No stimulus: nothing but the image and the fingers' neighbours
+    // decides a joint.
+    for (int i = 1; i < 4; ++i) {
+      e = tracker->process(half_covered(*tracker, setup, truth, i + 1), i, i / 30.0, std::nullopt);
+    }
+    return std::make_pair(std::move(tracker), e);
+  };
+  const auto [off_tracker, off] = track(0);
+  const auto [on_tracker, on] = track(0.001);
+  EXPECT_EQ(on.status, gtrack::TrackStatus::Tracked);
+  // The search left the fingers off (the hidden ones most), and the fill
+  // brings the reported joints nearer the truth.
+  EXPECT_GT(joint_error(off.hypothesis), 4.0) << off.hypothesis.transpose();
+  EXPECT_LT(joint_error(on.hypothesis), joint_error(off.hypothesis) - 1.0) << on.hypothesis.transpose();
+  // The fill changes joints only, costs at most the tolerance, and the track
+  // goes on from the search's own result: the same as without the fill.
+  const Eigen::VectorXd& state = *on_tracker->last_estimate();
+  EXPECT_EQ(state, off.hypothesis);
+  EXPECT_EQ(on.hypothesis.head<6>(), state.head<6>());
+  EXPECT_NE(on.hypothesis.tail(6), state.tail(6));
+  EXPECT_LE(on.terms.total, on_tracker->score(state).total + 0.001);
+  EXPECT_DOUBLE_EQ(on_tracker->score(on.hypothesis).total, on.terms.total);
+  // Filled fingers share one value, the seen fingers' mean.
+  const Eigen::VectorXd q = on.hypothesis.tail(6), s = state.tail(6);
+  int filled = 0;
+  double seen_sum = 0;
+  for (int k = 0; k < 6; ++k) {
+    if (q[k] != s[k]) {
+      ++filled;
+    } else {
+      seen_sum += s[k];
+    }
+  }
+  ASSERT_GT(filled, 0);
+  ASSERT_LT(filled, 6);
+  for (int k = 0; k < 6; ++k) {
+    if (q[k] != s[k]) EXPECT_NEAR(q[k], seen_sum / (6 - filled), 1e-9) << k;
+  }
+  for (const char* bad : {"-0.001", "2.0", "\"small\""}) {
+    const std::string m = engine_config_error(std::string("[tracker]\nunseen_joint_tolerance = ") + bad + "\n");
+    EXPECT_NE(m.find("unseen_joint_tolerance"), std::string::npos) << m;
+    EXPECT_NE(m.find("<test>:"), std::string::npos) << m;
+  }
+}
+
 TEST(EngineConfig, PaperDefaults) {
   auto setup = make_setup();
   const auto c = gtrack::engine_config(setup);
@@ -811,6 +875,7 @@ TEST(EngineConfig, PaperDefaults) {
   EXPECT_TRUE(c.tracker.mirror_check);
   EXPECT_DOUBLE_EQ(c.tracker.refine_spread, 0.25);  // 0 = no refinement swarm
   EXPECT_TRUE(c.tracker.coarse_wide_tilts);
+  EXPECT_DOUBLE_EQ(c.tracker.unseen_joint_tolerance, 0.001);  // 0 = joints reported as searched
   // Depth spread: a quarter of the in-plane one (model radius 2 mm).
   EXPECT_NEAR(c.tracker.init_spread[2], 0.25 * c.tracker.init_spread[0], 1e-12);
   EXPECT_EQ(c.space.dims(), 12);

@@ -158,6 +158,12 @@ struct TrackerConfig {
   // initialised uniformly within refine_spread spreads, the previous
   // release's refinement).
   std::string refine_optimizer = "cmaes";
+  // Unseen fingers (docs/tracker.md): a finger whose joint can be moved to
+  // the other fingers' mean for at most this much cost E is one the image
+  // does not see; the estimate reports such fingers at the mean fold of the
+  // seen ones when that costs at most this much too (the track itself goes
+  // on from the search's result). 0 = off (the paper's tracker).
+  double unseen_joint_tolerance = 0.001;
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4
 };

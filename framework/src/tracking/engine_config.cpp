@@ -144,6 +144,8 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.mirror_particles = static_cast<int>(t.integer_or("mirror_particles", c.mirror_particles, Range::closed(0, 1 << 16)));
   c.refine_spread = t.number_or("refine_spread", c.refine_spread, Range::closed(0.0, 10.0));
   c.refine_optimizer = t.choice_or("refine_optimizer", c.refine_optimizer, {"cmaes", "pso"});
+  c.unseen_joint_tolerance =
+      t.number_or("unseen_joint_tolerance", c.unseen_joint_tolerance, Range::closed(0.0, 1.0));
   c.progress_every = static_cast<int>(t.integer_or("progress_every", c.progress_every, Range::closed(1, 1e9)));
   c.overlay = t.boolean_or("overlay", c.overlay);
   return c;

@@ -364,6 +364,11 @@ struct Tracker::Impl {
           terms = score(best);
         }
       }
+      // What is reported: the result, with the joints of the fingers the
+      // image does not see filled in. The track goes on from the result
+      // itself, so that the fill, a choice within what the image allows,
+      // never steers the next frame's search.
+      const Eigen::VectorXd reported = with_unseen_joints_filled(best, terms);
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
       e.outside_allowance = cost->outside_allowance();  // re-detection may have widened O
       e.observed_pixels = observation.count;
@@ -393,13 +398,51 @@ struct Tracker::Impl {
         }
         last_found = e.status == TrackStatus::Search || e.redetected;
         last = best;
-        e.hypothesis = best;
+        e.hypothesis = reported;
       }
     }
     started = true;
     e.times.pso_ms = ms_since(t1);
     e.ms = ms_since(t0);
     return e;
+  }
+
+  // Unseen fingers (docs/tracker.md, "Unseen fingers"): under an occluder,
+  // beyond the image's border or outside an ultrasound slab, a finger's
+  // joint does not change what is rendered inside O, and the search leaves it
+  // wherever its last best particle had it. One stimulus drives every finger,
+  // so the seen fingers' fold is the best guess for the others. A finger is
+  // unseen when moving its joint to the other fingers' mean raises E by at
+  // most unseen_joint_tolerance (one batch of F hypotheses); the unseen ones
+  // then take the seen ones' mean fold, kept if E rises by at most the
+  // tolerance again. `terms` becomes the reported configuration's.
+  Eigen::VectorXd with_unseen_joints_filled(const Eigen::VectorXd& best, CostTerms& terms) {
+    const int fingers = config.space.fingers();
+    const double tolerance = config.tracker.unseen_joint_tolerance;
+    if (tolerance <= 0 || fingers < 2) return best;
+    const Eigen::VectorXd q = best.tail(fingers);
+    Eigen::MatrixXd moved = best.replicate(1, fingers);
+    for (int k = 0; k < fingers; ++k) moved(kPoseDims + k, k) = (q.sum() - q[k]) / (fingers - 1);
+    Eigen::VectorXd costs;
+    cost->evaluate(moved, costs);
+    std::vector<int> unseen;
+    double seen_sum = 0;
+    for (int k = 0; k < fingers; ++k) {
+      if (costs[k] <= terms.total + tolerance) {
+        unseen.push_back(k);
+      } else {
+        seen_sum += q[k];
+      }
+    }
+    const int seen = fingers - static_cast<int>(unseen.size());
+    if (unseen.empty() || seen == 0) return best;
+    Eigen::VectorXd filled = best;
+    for (int k : unseen) filled[kPoseDims + k] = seen_sum / seen;
+    config.space.clamp(filled);
+    const CostTerms filled_terms = cost->evaluate_one(filled);
+    if (filled_terms.total > terms.total + tolerance) return best;
+    terms = filled_terms;
+    return filled;
   }
 
   // No velocity and no found step: the next estimate starts a new track.
