@@ -353,6 +353,7 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   ASSERT_EQ(jsonl.size(), 5u);
   EXPECT_NE(jsonl[4].find("\"stimulus\":30.0000"), std::string::npos) << jsonl[4];
   EXPECT_NE(jsonl[0].find("\"D\":"), std::string::npos);
+  EXPECT_NE(jsonl[0].find("\"unseen_fingers\":["), std::string::npos) << jsonl[0];
   EXPECT_TRUE(fs::exists(opt.out_dir / "summary.json"));
   EXPECT_TRUE(fs::exists(opt.out_dir / "masks" / "000004.png"));
   EXPECT_FALSE(s.overlay_file.empty());
@@ -839,6 +840,9 @@ TEST(Tracker, UnseenFingersTakeTheSeenFingersFold) {
   }
   ASSERT_GT(filled, 0);
   ASSERT_LT(filled, 6);
+  EXPECT_TRUE(off.unseen_fingers.empty());
+  ASSERT_EQ(on.unseen_fingers.size(), static_cast<std::size_t>(filled));
+  for (int f : on.unseen_fingers) EXPECT_NE(q[f - 1], s[f - 1]) << "finger " << f;
   for (int k = 0; k < 6; ++k) {
     if (q[k] != s[k]) EXPECT_NEAR(q[k], seen_sum / (6 - filled), 1e-9) << k;
   }

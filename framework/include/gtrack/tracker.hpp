@@ -35,6 +35,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "gtrack/cost.hpp"
 #include "gtrack/engine_config.hpp"
@@ -75,6 +76,9 @@ struct Estimate {
   std::uint64_t evaluations = 0;      // hypotheses scored for this frame
   bool redetected = false;            // the coarse search's result replaced the tracked one
   bool mirrored = false;              // the tilt mirror of the result scored lower and replaced it
+  // Fingers (1 = q1) the image did not see, whose joints are reported at
+  // the seen fingers' mean fold ([tracker] unseen_joint_tolerance).
+  std::vector<int> unseen_fingers;
   // A reference configuration (TrackOptions::score_truth) scored on this
   // frame exactly as the estimate was: same observation, allowance,
   // temporal prediction and stimulus.

@@ -109,6 +109,9 @@ std::string estimate_json(const Estimate& e) {
        ",\"overlap_pixels\":" + std::to_string(e.terms.overlap) + ",\"rim_pixels\":" + std::to_string(e.terms.rim) +
        ",\"redetected\":" +
        (e.redetected ? "true" : "false") + ",\"mirrored\":" + (e.mirrored ? "true" : "false");
+  j += ",\"unseen_fingers\":[";
+  for (std::size_t k = 0; k < e.unseen_fingers.size(); ++k) j += (k ? "," : "") + std::to_string(e.unseen_fingers[k]);
+  j += "]";
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);

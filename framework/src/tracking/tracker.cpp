@@ -368,7 +368,7 @@ struct Tracker::Impl {
       // image does not see filled in. The track goes on from the result
       // itself, so that the fill, a choice within what the image allows,
       // never steers the next frame's search.
-      const Eigen::VectorXd reported = with_unseen_joints_filled(best, terms);
+      const Eigen::VectorXd reported = with_unseen_joints_filled(best, terms, e.unseen_fingers);
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
       e.outside_allowance = cost->outside_allowance();  // re-detection may have widened O
       e.observed_pixels = observation.count;
@@ -415,8 +415,10 @@ struct Tracker::Impl {
   // unseen when moving its joint to the other fingers' mean raises E by at
   // most unseen_joint_tolerance (one batch of F hypotheses); the unseen ones
   // then take the seen ones' mean fold, kept if E rises by at most the
-  // tolerance again. `terms` becomes the reported configuration's.
-  Eigen::VectorXd with_unseen_joints_filled(const Eigen::VectorXd& best, CostTerms& terms) {
+  // tolerance again. `terms` becomes the reported configuration's, and
+  // `filled_fingers` lists the fingers filled in (1 = q1).
+  Eigen::VectorXd with_unseen_joints_filled(const Eigen::VectorXd& best, CostTerms& terms,
+                                            std::vector<int>& filled_fingers) {
     const int fingers = config.space.fingers();
     const double tolerance = config.tracker.unseen_joint_tolerance;
     if (tolerance <= 0 || fingers < 2) return best;
@@ -442,6 +444,7 @@ struct Tracker::Impl {
     const CostTerms filled_terms = cost->evaluate_one(filled);
     if (filled_terms.total > terms.total + tolerance) return best;
     terms = filled_terms;
+    for (int k : unseen) filled_fingers.push_back(k + 1);
     return filled;
   }
 
