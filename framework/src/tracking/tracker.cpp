@@ -368,17 +368,18 @@ struct Tracker::Impl {
       // image does not see filled in. The track goes on from the result
       // itself, so that the fill, a choice within what the image allows,
       // never steers the next frame's search.
-      const Eigen::VectorXd reported = with_unseen_joints_filled(best, terms, e.unseen_fingers);
+      // Whether the frame is lost is the result's own fit.
+      CostTerms reported_terms = terms;
+      e.hypothesis = with_unseen_joints_filled(best, reported_terms, e.unseen_fingers);
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
       e.outside_allowance = cost->outside_allowance();  // re-detection may have widened O
       e.observed_pixels = observation.count;
-      e.terms = terms;
-      if (e.terms.dice > config.tracker.lost_dice) {
+      e.terms = reported_terms;
+      if (terms.dice > config.tracker.lost_dice) {
         ++lost;
         e.status = TrackStatus::Lost;
         if (!last) last = best;
         forget_motion();
-        e.hypothesis = best;
       } else {
         lost = 0;
         // A velocity needs two estimates of one continuous track: not across
@@ -398,7 +399,6 @@ struct Tracker::Impl {
         }
         last_found = e.status == TrackStatus::Search || e.redetected;
         last = best;
-        e.hypothesis = reported;
       }
     }
     started = true;
