@@ -367,8 +367,8 @@ struct Tracker::Impl {
       // What is reported: the result, with the joints of the fingers the
       // image does not see filled in. The track goes on from the result
       // itself, so that the fill, a choice within what the image allows,
-      // never steers the next frame's search.
-      // Whether the frame is lost is the result's own fit.
+      // never steers the next frame's search, nor decides whether the frame
+      // is lost.
       CostTerms reported_terms = terms;
       e.hypothesis = with_unseen_joints_filled(best, reported_terms, e.unseen_fingers);
       e.evaluations = cost->evaluations() - evals0 - bookkeeping;
