@@ -233,6 +233,13 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
         std::cout << "none\n";
       }
     }
+    if (ev.tilt_branch_frames > 0) {
+      // The same, whatever the fold: folded, the outline tells the two
+      // branches apart, but an occluder or the border may hide what does.
+      std::cout << "  other branch of the tilt's sign, any fold: " << ev.tilt_branch_frames << " frames, "
+                << std::fixed << std::setprecision(0) << 100 * ev.tilt_branch_orientation_share
+                << " % of the orientation error\n";
+    }
   }
   std::cout << "  recovery: " << ev.recovery.size() << " returns into view, " << ev.frames_lost_after_return
             << " frames lost or off track after them\n";

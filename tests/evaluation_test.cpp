@@ -75,7 +75,7 @@ TEST(Evaluation, GeodesicAngle) {
   EXPECT_NEAR(gtrack::geodesic_angle_deg({20, 30, 40}, {20 + 180, 180 - 30, 40 + 180}), 0, 1e-9);
 }
 
-TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripper) {
+TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripperAndTheOtherTiltBranch) {
   auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
   const auto& m = g->model();
   const std::vector<double> flat(6, 0.0), folded(6, 30.0);
@@ -84,19 +84,29 @@ TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripper) {
   const Eigen::VectorXd truth = pose(0, 0, 100, 20, 0, 15, flat);
   const auto mirrored = gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -20, 0, 15, flat));
   EXPECT_TRUE(mirrored.tilt_mirror);
+  EXPECT_TRUE(mirrored.tilt_branch);
   EXPECT_NEAR(mirrored.orientation_deg, 40, 1e-6);
   // The mirror is judged on the palm normal, whatever the turn about the
   // optical axis.
   EXPECT_TRUE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, -18, 3, 70, flat)).tilt_mirror);
-  EXPECT_FALSE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 17, -2, 15, flat)).tilt_mirror);
-  // A folded truth's outline tells the tilts apart: never flagged.
-  EXPECT_FALSE(gtrack::compare_to_truth(m, pose(0, 0, 100, 20, 0, 15, folded), pose(0, 0, 100, -20, 0, 15, folded))
-                   .tilt_mirror);
-  // Upside down is not the mirror.
-  EXPECT_FALSE(gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 20 + 180, 0, 15, flat)).tilt_mirror);
+  const auto same_branch = gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 17, -2, 15, flat));
+  EXPECT_FALSE(same_branch.tilt_mirror);
+  EXPECT_FALSE(same_branch.tilt_branch);
+  // A folded truth's outline tells the tilts apart: never the flat mirror,
+  // but the estimate is on the other branch of the tilt's sign.
+  const Eigen::VectorXd folded_truth = pose(0, 0, 100, 20, 0, 15, folded);
+  const Eigen::VectorXd folded_other = pose(0, 0, 100, -20, 0, 15, folded);
+  EXPECT_FALSE(gtrack::compare_to_truth(m, folded_truth, folded_other).tilt_mirror);
+  EXPECT_TRUE(gtrack::compare_to_truth(m, folded_truth, folded_other).tilt_branch);
+  // Upside down is neither.
+  const auto upside_down = gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 20 + 180, 0, 15, flat));
+  EXPECT_FALSE(upside_down.tilt_mirror);
+  EXPECT_FALSE(upside_down.tilt_branch);
   // Nearly untilted: the two are the same configuration.
-  EXPECT_FALSE(
-      gtrack::compare_to_truth(m, pose(0, 0, 100, 2, 0, 0, flat), pose(0, 0, 100, -2, 0, 0, flat)).tilt_mirror);
+  const auto untilted =
+      gtrack::compare_to_truth(m, pose(0, 0, 100, 2, 0, 0, flat), pose(0, 0, 100, -2, 0, 0, flat));
+  EXPECT_FALSE(untilted.tilt_mirror);
+  EXPECT_FALSE(untilted.tilt_branch);
 
   // Judged about the line of sight: seen along x, the same pair is no mirror,
   // and the mirror about x is.
@@ -121,19 +131,25 @@ TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripper) {
 
   // Over a sequence: the count, the share of the summed orientation error,
   // and the other frames' error. Frames 0-1 mirrored (40 deg each), 2 off
-  // by 10 deg, 3 exact, 4 lost (not counted).
+  // by 10 deg, 3 exact, 4 lost (not counted), 5 folded and on the other
+  // branch (40 deg): two flat mirrors, three on the other branch.
   gtrack::PoseTable t, e;
   t.fingers = e.fingers = 6;
   for (int f = 0; f < 5; ++f) t.rows.push_back(row(f, truth));
+  t.rows.push_back(row(5, folded_truth));
   e.rows = {row(0, pose(0, 0, 100, -20, 0, 15, flat)), row(1, pose(0, 0, 100, -20, 0, 15, flat)),
-            row(2, pose(0, 0, 100, 30, 0, 15, flat)), row(3, truth), row(4, truth, "lost")};
+            row(2, pose(0, 0, 100, 30, 0, 15, flat)), row(3, truth), row(4, truth, "lost"), row(5, folded_other)};
   const auto ev = gtrack::evaluate(m, t, e);
   EXPECT_EQ(ev.tilt_mirror_frames, 2);
-  EXPECT_NEAR(ev.tilt_mirror_orientation_share, 80.0 / 90.0, 1e-6);
-  EXPECT_EQ(ev.orientation_without_tilt_mirror_deg.count, 2);
-  EXPECT_NEAR(ev.orientation_without_tilt_mirror_deg.mean, 5, 1e-6);
-  EXPECT_NEAR(ev.in_view.orientation_deg.mean, 22.5, 1e-6) << "the headline error is unchanged";
-  EXPECT_NE(gtrack::evaluation_json(ev).find("\"tilt_mirror\": {\"frames\": 2"), std::string::npos);
+  EXPECT_NEAR(ev.tilt_mirror_orientation_share, 80.0 / 130.0, 1e-6);
+  EXPECT_EQ(ev.orientation_without_tilt_mirror_deg.count, 3);
+  EXPECT_NEAR(ev.orientation_without_tilt_mirror_deg.mean, 50.0 / 3, 1e-6);
+  EXPECT_EQ(ev.tilt_branch_frames, 3);
+  EXPECT_NEAR(ev.tilt_branch_orientation_share, 120.0 / 130.0, 1e-6);
+  EXPECT_NEAR(ev.in_view.orientation_deg.mean, 26, 1e-6) << "the headline error is unchanged";
+  const std::string json = gtrack::evaluation_json(ev);
+  EXPECT_NE(json.find("\"tilt_mirror\": {\"frames\": 2"), std::string::npos);
+  EXPECT_NE(json.find("\"tilt_branch\": {\"frames\": 3"), std::string::npos);
 }
 
 TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {

@@ -63,6 +63,12 @@ struct FrameErrors {
   // v the plane's normal): such a frame's orientation error is the tilt's
   // sign, which the image barely holds. A diagnostic; it changes no error.
   bool tilt_mirror = false;
+  // The same test of the palm normal (e.m > |e.n|, the truth tilted by more
+  // than kMirrorMinTiltDeg), whatever the fold: the estimate is on the other
+  // branch of the tilt's sign. For a folded gripper the outline does tell
+  // the two apart, but under an occluder or at the image's border little of
+  // it is seen. tilt_mirror is this and a flat truth. A diagnostic too.
+  bool tilt_branch = false;
   static constexpr double kFlatShare = 0.05;
   static constexpr double kMirrorMinTiltDeg = 3.0;
 };
@@ -123,6 +129,11 @@ struct Evaluation {
   int tilt_mirror_frames = 0;
   double tilt_mirror_orientation_share = 0;
   ErrorStats orientation_without_tilt_mirror_deg;
+  // Evaluated frames on the other tilt branch, whatever the fold
+  // (FrameErrors::tilt_branch), and the share of the summed orientation
+  // error they carry.
+  int tilt_branch_frames = 0;
+  double tilt_branch_orientation_share = 0;
   std::vector<RecoveryEpisode> recovery;
   int frames_lost_after_return = 0;
   std::vector<FrameEvaluation> per_frame;

@@ -69,7 +69,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   const bool dims_match = estimates.fingers == model.fingers();
   const std::optional<Projection> projection = sensor ? std::optional<Projection>(sensor->projection()) : std::nullopt;
   std::vector<double> unmirrored;  // orientation errors of in-view frames that are no tilt mirror
-  double mirrored_sum = 0, orientation_sum = 0;
+  double mirrored_sum = 0, branch_sum = 0, orientation_sum = 0;
 
   for (const PoseRow& t : truth.rows) {
     FrameEvaluation fe;
@@ -102,6 +102,10 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
         ev.in_view.add(fe.errors);
         ++ev.evaluated_frames;
         orientation_sum += fe.errors.orientation_deg;
+        if (fe.errors.tilt_branch) {
+          ++ev.tilt_branch_frames;
+          branch_sum += fe.errors.orientation_deg;
+        }
         if (fe.errors.tilt_mirror) {
           ++ev.tilt_mirror_frames;
           mirrored_sum += fe.errors.orientation_deg;
@@ -117,6 +121,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   ev.out_of_view.finish();
   ev.tilt_mirror_orientation_share = orientation_sum > 0 ? mirrored_sum / orientation_sum : 0;
   ev.orientation_without_tilt_mirror_deg = stats(unmirrored);
+  ev.tilt_branch_orientation_share = orientation_sum > 0 ? branch_sum / orientation_sum : 0;
 
   // Recovery: after each stretch out of view, frames until the estimate is
   // back on the gripper.

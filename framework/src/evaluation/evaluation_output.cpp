@@ -53,6 +53,8 @@ std::string evaluation_json(const Evaluation& ev) {
     << "  \"tilt_mirror\": {\"frames\": " << ev.tilt_mirror_frames
     << ", \"orientation_share\": " << num(ev.tilt_mirror_orientation_share)
     << ", \"orientation_other_frames_deg\": " << stats_json(ev.orientation_without_tilt_mirror_deg) << "},\n"
+    << "  \"tilt_branch\": {\"frames\": " << ev.tilt_branch_frames
+    << ", \"orientation_share\": " << num(ev.tilt_branch_orientation_share) << "},\n"
     << "  \"out_of_view\": {\n    \"frames\": " << ev.out_of_view_frames << ",\n";
   error_set_json(o, ev.out_of_view, "    ");
   int worst = 0, unrecovered = 0;
@@ -77,19 +79,19 @@ void write_frame_errors(const std::filesystem::path& file, const Evaluation& ev)
   std::ofstream out(file);
   if (!out) throw InputError(file.string() + ": cannot write");
   out << "frame,in_view,out_of_view,status,lost,position_um,inplane_um,depth_um,orientation_deg,rx_err_deg,"
-         "ry_err_deg,rz_err_deg,joint_deg,endpoint_um,symmetry_k,tilt_mirror\n";
+         "ry_err_deg,rz_err_deg,joint_deg,endpoint_um,symmetry_k,tilt_mirror,tilt_branch\n";
   for (const auto& f : ev.per_frame) {
     out << f.frame << "," << num(f.in_view) << "," << (f.out_of_view ? 1 : 0) << "," << f.status << ","
         << (f.lost ? 1 : 0);
     if (f.lost) {
-      out << ",,,,,,,,,,,\n";
+      out << ",,,,,,,,,,,,\n";
       continue;
     }
     const auto& e = f.errors;
     out << "," << num(e.position_um) << "," << num(e.inplane_um) << "," << num(e.depth_um) << ","
         << num(e.orientation_deg) << "," << num(e.axis_deg[0]) << "," << num(e.axis_deg[1]) << ","
         << num(e.axis_deg[2]) << "," << num(e.joint_deg) << "," << num(e.endpoint_um) << "," << e.symmetry_k << ","
-        << (e.tilt_mirror ? 1 : 0) << "\n";
+        << (e.tilt_mirror ? 1 : 0) << "," << (e.tilt_branch ? 1 : 0) << "\n";
   }
   if (!out) throw InputError(file.string() + ": write failed");
 }
