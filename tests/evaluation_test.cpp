@@ -96,8 +96,9 @@ TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripperAndTheOtherTiltBranch) {
   // but the estimate is on the other branch of the tilt's sign.
   const Eigen::VectorXd folded_truth = pose(0, 0, 100, 20, 0, 15, folded);
   const Eigen::VectorXd folded_other = pose(0, 0, 100, -20, 0, 15, folded);
-  EXPECT_FALSE(gtrack::compare_to_truth(m, folded_truth, folded_other).tilt_mirror);
-  EXPECT_TRUE(gtrack::compare_to_truth(m, folded_truth, folded_other).tilt_branch);
+  const auto folded_pair = gtrack::compare_to_truth(m, folded_truth, folded_other);
+  EXPECT_FALSE(folded_pair.tilt_mirror);
+  EXPECT_TRUE(folded_pair.tilt_branch);
   // Upside down is neither.
   const auto upside_down = gtrack::compare_to_truth(m, truth, pose(0, 0, 100, 20 + 180, 0, 15, flat));
   EXPECT_FALSE(upside_down.tilt_mirror);

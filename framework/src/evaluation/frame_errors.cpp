@@ -17,35 +17,31 @@ double mean_endpoint_distance(const std::vector<Eigen::Vector3d>& a, const std::
   return a.empty() ? 0.0 : sum / a.size();
 }
 
-// Whether the estimate's palm normal is on the other branch of a tilted
-// truth's tilt sign (FrameErrors::tilt_branch), and whether that truth is
-// flat as well (FrameErrors::tilt_mirror).
-struct TiltBranch {
-  bool other_branch = false;
-  bool flat_mirror = false;
-};
-
-TiltBranch tilt_branch(const ArticulatedModel& model, const Eigen::VectorXd& truth, const Eigen::VectorXd& estimate,
-                       const Eigen::Vector3d& line_of_sight) {
-  if (line_of_sight.norm() == 0) return {};
+// The estimate's palm normal is on the other branch of a tilted truth's
+// tilt sign (FrameErrors::tilt_branch).
+bool on_other_tilt_branch(const Eigen::VectorXd& truth, const Eigen::VectorXd& estimate,
+                          const Eigen::Vector3d& line_of_sight) {
+  if (line_of_sight.norm() == 0) return false;
   const Eigen::Vector3d v = line_of_sight.normalized();
   const Eigen::Vector3d n = rotation_from_euler_deg(truth[3], truth[4], truth[5]).col(2);
   const Eigen::Vector3d m = 2 * n.dot(v) * v - n;
   const Eigen::Vector3d e = rotation_from_euler_deg(estimate[3], estimate[4], estimate[5]).col(2);
   const double tilt_deg = std::acos(std::clamp(std::abs(n.dot(v)), 0.0, 1.0)) * 180.0 / std::numbers::pi;
   // Nearer the mirror than the truth, and not upside down (e near -n).
-  TiltBranch b;
-  b.other_branch = tilt_deg > FrameErrors::kMirrorMinTiltDeg && e.dot(m) > std::abs(e.dot(n));
-  if (!b.other_branch) return b;
-  Eigen::VectorXd shape = truth;
+  return tilt_deg > FrameErrors::kMirrorMinTiltDeg && e.dot(m) > std::abs(e.dot(n));
+}
+
+// Every link of the configuration lies within kFlatShare of the model's
+// radius of the palm plane.
+bool is_flat(const ArticulatedModel& model, const Eigen::VectorXd& h) {
+  Eigen::VectorXd shape = h;
   shape.head<kPoseDims>().setZero();  // the model frame: the palm in its XY plane
   double lo = 0, hi = 0;
   for (const Eigen::Vector3d& p : model.link_endpoints(shape)) {
     lo = std::min(lo, p.z());
     hi = std::max(hi, p.z());
   }
-  b.flat_mirror = hi - lo <= FrameErrors::kFlatShare * model.radius_mm();
-  return b;
+  return hi - lo <= FrameErrors::kFlatShare * model.radius_mm();
 }
 
 }  // namespace
@@ -99,9 +95,8 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
     f.joint_deg = F ? joints / F : 0;
     best = f;
   }
-  const TiltBranch branch = tilt_branch(model, truth, estimate, line_of_sight);
-  best.tilt_branch = branch.other_branch;
-  best.tilt_mirror = branch.flat_mirror;
+  best.tilt_branch = on_other_tilt_branch(truth, estimate, line_of_sight);
+  best.tilt_mirror = best.tilt_branch && is_flat(model, truth);
   return best;
 }
 
