@@ -11,6 +11,7 @@
 #include "gtrack/results.hpp"
 #include "gtrack/setup.hpp"
 #include "gtrack/tracker.hpp"
+#include "gtrack/two_pass.hpp"
 
 namespace po = boost::program_options;
 
@@ -77,6 +78,22 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
       }
     };
   }
+  // --two-pass: the estimates are kept as they are made, for the backward
+  // pass that follows the forward one.
+  const bool two_pass = vm.count("two-pass") > 0;
+  std::vector<gtrack::Estimate> forward;
+  if (two_pass) {
+    if (opt.input.rfind("camera:", 0) == 0) throw gtrack::cli::UsageError("--two-pass needs a recording, not a live camera");
+    if (opt.resume) throw gtrack::cli::UsageError("--two-pass cannot be combined with --resume");
+    if (opt.follow_input_s > 0 || opt.follow_stimulus) {
+      throw gtrack::cli::UsageError("--two-pass cannot be combined with --follow-input or --follow-stimulus");
+    }
+    if (opt.restart_from) throw gtrack::cli::UsageError("--two-pass cannot be combined with --restart-from");
+    opt.on_frame = [&forward, streamed = opt.on_frame](const gtrack::Estimate& e) {
+      if (streamed) streamed(e);
+      forward.push_back(e);
+    };
+  }
   opt.cancel = &g_stop;
   install_sigint();
 
@@ -96,6 +113,17 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
   }
   if (s.cancelled) return g_reader_gone ? 141 : 130;  // 141: as a process ended by SIGPIPE
+  if (two_pass) {
+    const gtrack::TwoPassSummary t = gtrack::two_pass(setup, config, opt, forward);
+    if (t.cancelled) {
+      std::cerr << "gtrack track: the backward pass was interrupted; its finished frames are in "
+                << (opt.out_dir / "backward").string() << ", no two-pass table was written\n";
+      return 130;
+    }
+    std::fprintf(report, "two-pass: %d frames, %d taken from the backward pass (%d lost there), %.1f s -> %s\n",
+                 t.frames, t.from_backward, t.backward_lost, t.wall_s,
+                 (opt.out_dir / "two_pass" / "estimates.csv").string().c_str());
+  }
   return 0;
 }
 
@@ -114,6 +142,9 @@ GTRACK_COMMAND(
           "A:B, frames A (inclusive) to B (exclusive); A: and :B open-ended; A alone: that frame")(
           "save-masks", "write each observation O to OUT/masks/NNNNNN.png")(
           "no-overlay", "do not write the overlay video")(
+          "two-pass",
+          "after the run, track the recording again backwards and write OUT/two_pass/estimates.csv: per frame, "
+          "the forward or the backward estimate, whichever scores lower")(
           "resume", "continue the run whose files are in OUT after its last finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
           "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(

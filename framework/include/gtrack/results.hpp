@@ -41,7 +41,8 @@ GTRACK_API int remove_frame_images(const std::filesystem::path& dir);
 
 // A fresh run into a folder that holds an earlier one: removes the files of
 // that run this one might not rewrite (overlay videos, masks, the tracker
-// state, the summary), so nothing of the two is mixed. Returns how many were removed.
+// state, the summary, a --two-pass run's backward/ and two_pass/ tables), so
+// nothing of the two is mixed. Returns how many were removed.
 GTRACK_API int clear_previous_run(const std::filesystem::path& out_dir);
 
 // Prepares out_dir for a resumed run: keeps the rows of estimates.csv and

@@ -192,6 +192,12 @@ int clear_previous_run(const fs::path& out_dir) {
                          (p.extension() == ".mp4" || p.extension() == ".avi");
     if (overlay || n == "tracker_state.txt" || n == "summary.json") stale.push_back(p);
   }
+  // An earlier --two-pass run's backward track and two-pass table.
+  for (const char* sub : {"backward", "two_pass"}) {
+    for (const char* file : {"estimates.csv", "estimates.jsonl"}) {
+      if (fs::exists(out_dir / sub / file, ec)) stale.push_back(out_dir / sub / file);
+    }
+  }
   remove_all_of(stale);
   return static_cast<int>(stale.size()) + remove_frame_images(out_dir / "masks");
 }

@@ -1,0 +1,186 @@
+// The backward pass over a recorded sequence, and the two-pass table.
+#include "gtrack/two_pass.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <span>
+
+#include "gtrack/error.hpp"
+#include "gtrack/frame_source.hpp"
+#include "gtrack/log.hpp"
+#include "gtrack/results.hpp"
+
+namespace gtrack {
+
+namespace {
+
+// The stimulus as the forward run had it at one frame: seek() makes a fresh
+// instance of the configured plugin and feeds it the readings of the
+// forward run's frames up to that one. The tracker's own update() calls are
+// ignored. The fold bias is turned around: backward in time, a gripper that
+// was folding unfolds.
+class ReplayedStimulus final : public Stimulus {
+ public:
+  explicit ReplayedStimulus(const Setup& setup) : loader_(setup.loader), table_(setup.root.table("stimulus")) {}
+
+  void seek(const std::vector<Estimate>& forward, std::size_t k) {
+    now_ = loader_->make_stimulus(table_);
+    for (std::size_t i = 0; i <= k; ++i) {
+      if (forward[i].stimulus) now_->update(*forward[i].stimulus, forward[i].time_s);
+    }
+  }
+
+  void update(double, double) override {}
+  StimulusState state() const override { return now_->state(); }
+  double penalty(std::span<const double> joints_deg) const override { return now_->penalty(joints_deg); }
+  double fold_fraction() const override { return 1.0 - now_->fold_fraction(); }
+  double target_joint_deg(double current_deg) const override { return now_->target_joint_deg(current_deg); }
+  std::string reading_label() const override { return now_->reading_label(); }
+  std::string reading_unit() const override { return now_->reading_unit(); }
+
+ private:
+  std::shared_ptr<PluginLoader> loader_;
+  ConfigTable table_;
+  std::shared_ptr<Stimulus> now_;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Of h's symmetric equivalents (the same silhouette), the one whose angles
+// are nearest `to`'s, so that the temporal term compares like with like.
+Eigen::VectorXd nearest_equivalent(const ArticulatedModel& model, const Eigen::VectorXd& h, const Eigen::VectorXd& to) {
+  Eigen::VectorXd best = h;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
+    const Eigen::VectorXd e = model.symmetric_equivalent(h, k);
+    double d = 0;
+    for (int a = 3; a < kPoseDims; ++a) d += std::pow(std::remainder(e[a] - to[a], 360.0), 2);
+    if (d < nearest) {
+      nearest = d;
+      best = e;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
+                        const std::vector<Estimate>& forward) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.input.rfind("camera:", 0) == 0) {
+    throw InputError("the backward pass goes back over a recording, not a live camera (" + options.input + ")");
+  }
+  TwoPassSummary summary;
+  if (forward.empty()) return summary;
+
+  // The backward tracker has a Setup of its own: the sensor and the gripper
+  // are shared, the stimulus is replayed frame by frame.
+  Setup back = setup;
+  std::shared_ptr<ReplayedStimulus> replay;
+  if (setup.stimulus && setup.loader) {
+    replay = std::make_shared<ReplayedStimulus>(setup);
+    back.stimulus = replay;
+  } else if (setup.stimulus) {
+    logger().warn("backward pass: the stimulus plugin cannot be made again (no plugin loader); the pass runs without it");
+    back.stimulus = nullptr;
+  }
+  Tracker tracker(back, config);
+  ResultWriter backward_results(options.out_dir / "backward", setup.model().fingers());
+  const double lt = config.cost.temporal;
+  const auto without_temporal = [lt](const CostTerms& t) { return t.total - lt * t.temporal; };
+
+  logger().info("backward pass over {} frames, from frame {} back to frame {}", forward.size(), forward.back().frame,
+                forward.front().frame);
+  std::vector<Estimate> backward(forward.size());
+  const int n = static_cast<int>(forward.size());
+  // Frames are read a block at a time, forward within the block.
+  constexpr int kBlock = 16;
+  const double fps = config.tracker.fps > 0 ? config.tracker.fps : 30.0;
+  for (int hi = n; hi > 0 && !summary.cancelled; hi -= kBlock) {
+    const int lo = std::max(0, hi - kBlock);
+    std::set<int> wanted;
+    for (int k = lo; k < hi; ++k) wanted.insert(forward[static_cast<std::size_t>(k)].frame);
+    auto source = open_frame_source(options.input, setup.sensor->image_size(),
+                                    FrameRange{*wanted.begin(), *wanted.rbegin() + 1, 1}, fps);
+    std::map<int, cv::Mat> images;
+    while (auto f = source->next()) {
+      if (wanted.count(f->index)) images[f->index] = std::move(f->image);
+    }
+    for (int k = hi - 1; k >= lo; --k) {
+      if (options.cancel && options.cancel->load()) {
+        summary.cancelled = true;
+        break;
+      }
+      const Estimate& f = forward[static_cast<std::size_t>(k)];
+      const auto image = images.find(f.frame);
+      if (image == images.end()) {
+        throw InputError(options.input + ": frame " + std::to_string(f.frame) +
+                         " of the forward run can no longer be read; the backward pass needs the same input");
+      }
+      if (replay) replay->seek(forward, static_cast<std::size_t>(k));
+      Estimate b = tracker.process(image->second, f.frame, f.time_s, f.stimulus);
+      backward_results.write(b);
+      if (b.status == TrackStatus::Lost) ++summary.backward_lost;
+      backward[static_cast<std::size_t>(k)] = std::move(b);
+    }
+  }
+  backward_results.close();
+  if (summary.cancelled) {
+    summary.wall_s = seconds_since(start);
+    return summary;
+  }
+
+  // The forward run again (the same tracker, seed and stimulus: the same
+  // estimates), each backward estimate scored beside it as --score-truth
+  // scores a reference. The forward track's observation, allowance and
+  // stimulus state are the ones its search had its full chance on: a
+  // backward estimate that scores lower there is one that search missed.
+  Setup again = setup;
+  if (setup.stimulus && setup.loader) again.stimulus = setup.loader->make_stimulus(setup.root.table("stimulus"));
+  Tracker forward_again(again, config);
+  ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
+  FrameRange range = options.range;
+  range.first = forward.front().frame;
+  range.last = forward.back().frame + 1;
+  auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
+  std::size_t k = 0;
+  int differ = 0;
+  while (k < forward.size()) {
+    if (options.cancel && options.cancel->load()) {
+      summary.cancelled = true;
+      break;
+    }
+    auto frame = source->next();
+    if (!frame) break;
+    if (frame->index != forward[k].frame) continue;
+    const Estimate& f = forward[k];
+    Estimate e = forward_again.process(frame->image, f.frame, f.time_s, f.stimulus);
+    if (e.hypothesis != f.hypothesis) ++differ;
+    const Estimate& b = backward[k];
+    bool take_backward = false;
+    if (b.status != TrackStatus::Lost) {
+      const CostTerms b_here = forward_again.score(nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis));
+      take_backward = e.status == TrackStatus::Lost || without_temporal(b_here) < without_temporal(e.terms);
+    }
+    if (take_backward) ++summary.from_backward;
+    two_pass_results.write(take_backward ? b : e);
+    ++summary.frames;
+    ++k;
+  }
+  two_pass_results.close();
+  if (differ > 0) {
+    logger().warn("two-pass: the forward run, tracked again, gave other estimates on {} of {} frames", differ,
+                  summary.frames);
+  }
+  summary.wall_s = seconds_since(start);
+  return summary;
+}
+
+}  // namespace gtrack
