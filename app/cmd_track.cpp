@@ -83,7 +83,9 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const bool two_pass = vm.count("two-pass") > 0;
   std::vector<gtrack::Estimate> forward;
   if (two_pass) {
-    if (opt.input.rfind("camera:", 0) == 0) throw gtrack::cli::UsageError("--two-pass needs a recording, not a live camera");
+    if (opt.input.rfind("camera:", 0) == 0) {
+      throw gtrack::cli::UsageError("--two-pass needs a recording, not a live camera");
+    }
     if (opt.resume) throw gtrack::cli::UsageError("--two-pass cannot be combined with --resume");
     if (opt.follow_input_s > 0 || opt.follow_stimulus) {
       throw gtrack::cli::UsageError("--two-pass cannot be combined with --follow-input or --follow-stimulus");

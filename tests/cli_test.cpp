@@ -442,7 +442,9 @@ TEST(Cli, TwoPassTakesEachFrameFromTheForwardOrTheBackwardTrack) {
   ASSERT_EQ(forward.size(), 13u);
   ASSERT_EQ(backward.size(), 13u);
   ASSERT_EQ(both.size(), 13u);
-  const auto pose = [](const std::vector<std::string>& row) { return std::vector<std::string>(row.begin(), row.begin() + 13); };
+  const auto pose = [](const std::vector<std::string>& row) {
+    return std::vector<std::string>(row.begin(), row.begin() + 13);  // frame and the 12 parameters
+  };
   int from_backward = 0;
   for (int i = 1; i <= 12; ++i) {
     // The backward track's rows are written as made: the last frame first.

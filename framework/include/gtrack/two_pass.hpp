@@ -1,4 +1,4 @@
-// The backward pass of a recorded sequence (`gtrack track --two-pass`).
+// Two passes over a recorded sequence (`gtrack track --two-pass`).
 //
 // A track that settles in a wrong basin (the tilt's other branch under an
 // occluder, a sliver of the gripper coming back into view) stays there for
@@ -6,11 +6,14 @@
 // check correct it. On a recording, the frames before that correction can be
 // tracked again from it: the backward pass runs a second tracker over the
 // frames in reverse order, from its own coarse search on the last frame.
-// After each of its frames, the forward estimate of that frame is scored on
-// the same observation, occlusion allowance and stimulus state
-// (Tracker::score), and the two-pass table takes whichever scores lower, the
-// temporal term left out of the comparison (each track's prediction favours
-// its own estimate). docs/tracker.md, "The two-pass track", has the figures.
+// The forward run is then tracked again (the same seed: the same estimates),
+// and each frame's backward estimate is scored beside its forward one, on
+// the forward track's observation, occlusion allowance and stimulus state,
+// as --score-truth scores a reference (Tracker::score). The two-pass table
+// takes, over the whole sequence, the path through the two candidates that
+// minimises their costs (temporal term aside) plus the temporal term's
+// distance between consecutive estimates at the same weight λT.
+// docs/tracker.md, "Two passes over a recording", has the figures.
 //
 // The stimulus plugin's state is that of the forward run at the frame (the
 // readings up to it replayed into a fresh instance of the plugin), so the
@@ -31,7 +34,7 @@ struct TwoPassSummary {
   int frames = 0;         // frames of the two-pass table
   int from_backward = 0;  // of those, taken from the backward pass
   int backward_lost = 0;  // frames the backward pass reported lost
-  double wall_s = 0;      // the backward pass and the choice
+  double wall_s = 0;      // the backward pass, the forward run again and the choice
   bool cancelled = false; // interrupted: backward/ holds the frames done, no two-pass table is written
 };
 
@@ -39,7 +42,8 @@ struct TwoPassSummary {
 // track_sequence with `options`, its estimates in frame order) and writes,
 // in options.out_dir: backward/estimates.csv and .jsonl (the backward track,
 // rows appended as its frames are done, last frame first) and
-// two_pass/estimates.csv and .jsonl (frame order, once the pass is done).
+// two_pass/estimates.csv and .jsonl (frame order, once both passes are
+// done). The tracker's time is about three times the forward run's.
 // InputError for a live camera (no recording to go back over).
 GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                                    const std::vector<Estimate>& forward);

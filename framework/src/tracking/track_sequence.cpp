@@ -16,6 +16,7 @@
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
+#include "nearest_equivalent.hpp"
 
 namespace gtrack {
 
@@ -281,21 +282,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
     previous_index = frame->index;
     if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
-      // Of the reference's symmetric equivalents (the same silhouette), the
-      // one whose angles are nearest the estimate's, so that the temporal
-      // term compares like with like.
-      const ArticulatedModel& model = setup.model();
-      Eigen::VectorXd reference = row->second;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
-        const Eigen::VectorXd h = model.symmetric_equivalent(row->second, k);
-        double d = 0;
-        for (int a = 3; a < kPoseDims; ++a) d += std::pow(std::remainder(h[a] - e.hypothesis[a], 360.0), 2);
-        if (d < nearest) {
-          nearest = d;
-          reference = h;
-        }
-      }
+      // Of the reference's symmetric equivalents, the one nearest the estimate.
+      const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis);
       e.reference_terms = tracker.score(reference);
     }
 

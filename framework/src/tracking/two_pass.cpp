@@ -2,17 +2,19 @@
 #include "gtrack/two_pass.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
-#include <cmath>
 #include <limits>
 #include <map>
 #include <set>
 #include <span>
 
+#include "gtrack/cost.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/frame_source.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/results.hpp"
+#include "nearest_equivalent.hpp"
 
 namespace gtrack {
 
@@ -52,23 +54,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Of h's symmetric equivalents (the same silhouette), the one whose angles
-// are nearest `to`'s, so that the temporal term compares like with like.
-Eigen::VectorXd nearest_equivalent(const ArticulatedModel& model, const Eigen::VectorXd& h, const Eigen::VectorXd& to) {
-  Eigen::VectorXd best = h;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
-    const Eigen::VectorXd e = model.symmetric_equivalent(h, k);
-    double d = 0;
-    for (int a = 3; a < kPoseDims; ++a) d += std::pow(std::remainder(e[a] - to[a], 360.0), 2);
-    if (d < nearest) {
-      nearest = d;
-      best = e;
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
@@ -88,7 +73,8 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     replay = std::make_shared<ReplayedStimulus>(setup);
     back.stimulus = replay;
   } else if (setup.stimulus) {
-    logger().warn("backward pass: the stimulus plugin cannot be made again (no plugin loader); the pass runs without it");
+    logger().warn(
+        "backward pass: the stimulus plugin cannot be made again (no plugin loader); the pass runs without it");
     back.stimulus = nullptr;
   }
   Tracker tracker(back, config);
@@ -145,11 +131,16 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   Setup again = setup;
   if (setup.stimulus && setup.loader) again.stimulus = setup.loader->make_stimulus(setup.root.table("stimulus"));
   Tracker forward_again(again, config);
-  ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
   FrameRange range = options.range;
   range.first = forward.front().frame;
   range.last = forward.back().frame + 1;
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  // Per frame, the two candidates (0 the forward estimate, 1 the backward
+  // one) and their costs on the forward run's conditions, temporal term aside.
+  std::vector<std::array<const Estimate*, 2>> candidate(forward.size());
+  std::vector<std::array<double, 2>> node(forward.size(), {kNone, kNone});
+  std::vector<Estimate> again_estimates(forward.size());
   std::size_t k = 0;
   int differ = 0;
   while (k < forward.size()) {
@@ -161,24 +152,68 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     if (!frame) break;
     if (frame->index != forward[k].frame) continue;
     const Estimate& f = forward[k];
-    Estimate e = forward_again.process(frame->image, f.frame, f.time_s, f.stimulus);
+    again_estimates[k] = forward_again.process(frame->image, f.frame, f.time_s, f.stimulus);
+    const Estimate& e = again_estimates[k];
     if (e.hypothesis != f.hypothesis) ++differ;
     const Estimate& b = backward[k];
-    bool take_backward = false;
+    candidate[k] = {&e, &b};
     if (b.status != TrackStatus::Lost) {
-      const CostTerms b_here = forward_again.score(nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis));
-      take_backward = e.status == TrackStatus::Lost || without_temporal(b_here) < without_temporal(e.terms);
+      const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
+      node[k][1] = without_temporal(forward_again.score(b_here));
     }
-    if (take_backward) ++summary.from_backward;
-    two_pass_results.write(take_backward ? b : e);
-    ++summary.frames;
+    if (e.status != TrackStatus::Lost || b.status == TrackStatus::Lost) node[k][0] = without_temporal(e.terms);
+    logger().debug("frame {}: two-pass: forward {:.4f}, backward {:.4f}", f.frame, node[k][0], node[k][1]);
     ++k;
   }
-  two_pass_results.close();
   if (differ > 0) {
-    logger().warn("two-pass: the forward run, tracked again, gave other estimates on {} of {} frames", differ,
-                  summary.frames);
+    logger().warn("two-pass: the forward run, tracked again, gave other estimates on {} of {} frames", differ, k);
   }
+  if (summary.cancelled || k < forward.size()) {
+    summary.cancelled = true;
+    summary.wall_s = seconds_since(start);
+    return summary;
+  }
+  // The path through the candidates that minimises their costs plus, from
+  // each frame to the next, the temporal term's distance between the two
+  // estimates taken, at the same weight λT (a pose prior of zero velocity):
+  // where the frame cannot tell the two apart (a flat gripper's tilt
+  // mirror), the estimate that continues its neighbours' is taken.
+  Eigen::VectorXd sigma(config.space.dims());
+  sigma.head<kPoseDims>() = config.tracker.init_spread.head<kPoseDims>();
+  sigma.tail(sigma.size() - kPoseDims).setConstant(config.cost.temporal_joint_sigma_deg);
+  const bool wrap_rz = config.space.periodic.size() > 5 && config.space.periodic[5];
+  const auto step = [&](std::size_t i, int from, int to) {
+    const Eigen::VectorXd& h = candidate[i][to]->hypothesis;
+    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate[i - 1][from]->hypothesis, h);
+    return lt * temporal_distance(h, before, sigma, wrap_rz);
+  };
+  std::vector<std::array<double, 2>> total(forward.size());
+  std::vector<std::array<int, 2>> came(forward.size(), {0, 0});
+  total[0] = node[0];
+  for (std::size_t i = 1; i < forward.size(); ++i) {
+    for (int to = 0; to < 2; ++to) {
+      total[i][to] = kNone;
+      if (node[i][to] == kNone) continue;
+      for (int from = 0; from < 2; ++from) {
+        if (total[i - 1][from] == kNone) continue;
+        const double t = total[i - 1][from] + step(i, from, to) + node[i][to];
+        if (t < total[i][to]) {
+          total[i][to] = t;
+          came[i][to] = from;
+        }
+      }
+    }
+  }
+  std::vector<int> path(forward.size(), 0);
+  path.back() = total.back()[1] < total.back()[0] ? 1 : 0;
+  for (std::size_t i = forward.size() - 1; i > 0; --i) path[i - 1] = came[i][path[i]];
+  ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
+  for (std::size_t i = 0; i < forward.size(); ++i) {
+    summary.from_backward += path[i];
+    two_pass_results.write(*candidate[i][path[i]]);
+  }
+  two_pass_results.close();
+  summary.frames = static_cast<int>(forward.size());
   summary.wall_s = seconds_since(start);
   return summary;
 }

@@ -1,0 +1,31 @@
+// Of a configuration's symmetric equivalents, the one nearest another's.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "gtrack/model.hpp"
+
+namespace gtrack::detail {
+
+// Of h's symmetric equivalents (the same silhouette), the one whose angles
+// are nearest `to`'s, so that the temporal term compares like with like.
+inline Eigen::VectorXd nearest_equivalent(const ArticulatedModel& model, const Eigen::VectorXd& h,
+                                          const Eigen::VectorXd& to) {
+  Eigen::VectorXd best = h;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
+    const Eigen::VectorXd e = model.symmetric_equivalent(h, k);
+    double d = 0;
+    for (int a = 3; a < kPoseDims; ++a) d += std::pow(std::remainder(e[a] - to[a], 360.0), 2);
+    if (d < nearest) {
+      nearest = d;
+      best = e;
+    }
+  }
+  return best;
+}
+
+}  // namespace gtrack::detail
