@@ -100,12 +100,15 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   install_sigint();
 
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
+  // A two-pass run cannot be resumed: its backward pass needs the whole forward run.
+  const char* next = two_pass ? " (the same command with --resume instead of --two-pass continues the forward run)"
+                              : " (the same command with --resume continues)";
   if (s.cancelled && g_reader_gone) {
-    std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames
-              << " frames, kept in " << opt.out_dir.string() << " (the same command with --resume continues)\n";
+    std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames << " frames, kept in "
+              << opt.out_dir.string() << next << "\n";
   } else if (s.cancelled) {
     std::cerr << "gtrack track: interrupted; " << s.frames << " finished frames kept in " << opt.out_dir.string()
-              << " (the same command with --resume continues)\n";
+              << next << "\n";
   }
   std::FILE* report = stream ? stderr : stdout;
   std::fprintf(report, "%d frames (%d lost), mean cost %.4f, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
@@ -118,8 +121,9 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (two_pass) {
     const gtrack::TwoPassSummary t = gtrack::two_pass(setup, config, opt, forward);
     if (t.cancelled) {
-      std::cerr << "gtrack track: the backward pass was interrupted; its finished frames are in "
-                << (opt.out_dir / "backward").string() << ", no two-pass table was written\n";
+      std::cerr << "gtrack track: interrupted after the forward run (kept in " << opt.out_dir.string()
+                << "); the backward track's finished frames are in " << (opt.out_dir / "backward").string()
+                << ", no two-pass table was written\n";
       return 130;
     }
     std::fprintf(report, "two-pass: %d frames, %d taken from the backward pass (%d lost there), %.1f s -> %s\n",

@@ -77,7 +77,11 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
         "backward pass: the stimulus plugin cannot be made again (no plugin loader); the pass runs without it");
     back.stimulus = nullptr;
   }
-  Tracker tracker(back, config);
+  // It starts from its own coarse search on the last frame, whatever
+  // [tracker] initial_pose says of the first.
+  EngineConfig back_config = config;
+  back_config.tracker.initial_pose.reset();
+  Tracker tracker(back, back_config);
   ResultWriter backward_results(options.out_dir / "backward", setup.model().fingers());
   const double lt = config.cost.temporal;
   const auto without_temporal = [lt](const CostTerms& t) { return t.total - lt * t.temporal; };
@@ -86,15 +90,19 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
                 forward.front().frame);
   std::vector<Estimate> backward(forward.size());
   const int n = static_cast<int>(forward.size());
-  // Frames are read a block at a time, forward within the block.
-  constexpr int kBlock = 16;
+  // Frames are read a block at a time, forward within the block (a video
+  // is decoded again from its start for each block: blocks are as large as
+  // about 512 MB of frames allows).
+  const ImageSize size = setup.sensor->image_size();
+  const double frame_bytes = 3.0 * std::max(1, size.width) * std::max(1, size.height);
+  const int kBlock = std::clamp(static_cast<int>(512e6 / frame_bytes), 16, 4096);
+  const int every = std::max(1, options.range.every);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : 30.0;
   for (int hi = n; hi > 0 && !summary.cancelled; hi -= kBlock) {
     const int lo = std::max(0, hi - kBlock);
     std::set<int> wanted;
     for (int k = lo; k < hi; ++k) wanted.insert(forward[static_cast<std::size_t>(k)].frame);
-    auto source = open_frame_source(options.input, setup.sensor->image_size(),
-                                    FrameRange{*wanted.begin(), *wanted.rbegin() + 1, 1}, fps);
+    auto source = open_frame_source(options.input, size, FrameRange{*wanted.begin(), *wanted.rbegin() + 1, every}, fps);
     std::map<int, cv::Mat> images;
     while (auto f = source->next()) {
       if (wanted.count(f->index)) images[f->index] = std::move(f->image);
@@ -129,7 +137,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // stimulus state are the ones its search had its full chance on: a
   // backward estimate that scores lower there is one that search missed.
   Setup again = setup;
-  if (setup.stimulus && setup.loader) again.stimulus = setup.loader->make_stimulus(setup.root.table("stimulus"));
+  again.stimulus = back.stimulus ? setup.loader->make_stimulus(setup.root.table("stimulus")) : nullptr;
   Tracker forward_again(again, config);
   FrameRange range = options.range;
   range.first = forward.front().frame;
@@ -149,8 +157,11 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
       break;
     }
     auto frame = source->next();
-    if (!frame) break;
-    if (frame->index != forward[k].frame) continue;
+    if (frame && frame->index < forward[k].frame) continue;
+    if (!frame || frame->index != forward[k].frame) {
+      throw InputError(options.input + ": frame " + std::to_string(forward[k].frame) +
+                       " of the forward run can no longer be read; the two-pass run needs the same input");
+    }
     const Estimate& f = forward[k];
     again_estimates[k] = forward_again.process(frame->image, f.frame, f.time_s, f.stimulus);
     const Estimate& e = again_estimates[k];
@@ -168,8 +179,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   if (differ > 0) {
     logger().warn("two-pass: the forward run, tracked again, gave other estimates on {} of {} frames", differ, k);
   }
-  if (summary.cancelled || k < forward.size()) {
-    summary.cancelled = true;
+  if (summary.cancelled) {
     summary.wall_s = seconds_since(start);
     return summary;
   }
