@@ -124,6 +124,10 @@ class GTRACK_API Tracker {
   // the same observation, occlusion allowance, temporal prediction and
   // stimulus state. Throws before the first frame.
   CostTerms score(const Eigen::VectorXd& hypothesis);
+  // T of a configuration against another taken as the prediction (the
+  // temporal term's spreads, rz wrapped as the search space wraps it),
+  // without changing the tracker's own prediction.
+  double temporal_term(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& prediction) const;
   // The estimate drawn on a frame: posed triangles projected with
   // Sensor::project and filled in green with alpha, plus the stimulus reading
   // in the bottom-right corner.

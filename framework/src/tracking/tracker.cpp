@@ -121,8 +121,11 @@ struct Tracker::Impl {
     return s;
   }
 
+  // rz is compared modulo 360 when the search space wraps it.
+  bool wraps_rz() const { return config.space.periodic.size() > 5 && config.space.periodic[5]; }
+
   void set_temporal_prediction(const Eigen::VectorXd& prediction) {
-    cost->set_prediction(prediction, temporal_sigma(), config.space.periodic.size() > 5 && config.space.periodic[5]);
+    cost->set_prediction(prediction, temporal_sigma(), wraps_rz());
   }
 
   // Something to report before anything was ever found.
@@ -694,6 +697,10 @@ CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
   }
   return impl_->cost->evaluate_one(hypothesis);
 }
+double Tracker::temporal_term(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& prediction) const {
+  return temporal_distance(hypothesis, prediction, impl_->temporal_sigma(), impl_->wraps_rz());
+}
+
 Renderer& Tracker::renderer() { return *impl_->renderer; }
 const EngineConfig& Tracker::config() const { return impl_->config; }
 const ParameterSpace& Tracker::space() const { return impl_->config.space; }

@@ -9,7 +9,6 @@
 #include <set>
 #include <span>
 
-#include "gtrack/cost.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/frame_source.hpp"
 #include "gtrack/log.hpp"
@@ -144,11 +143,13 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   range.last = forward.back().frame + 1;
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
   constexpr double kNone = std::numeric_limits<double>::infinity();
-  // Per frame, the two candidates (0 the forward estimate, 1 the backward
-  // one) and their costs on the forward run's conditions, temporal term aside.
-  std::vector<std::array<const Estimate*, 2>> candidate(forward.size());
+  // Per frame, the costs of the two candidates (0 the forward estimate, 1
+  // the backward one) on the forward run's conditions, temporal term aside.
   std::vector<std::array<double, 2>> node(forward.size(), {kNone, kNone});
   std::vector<Estimate> again_estimates(forward.size());
+  const auto candidate = [&](std::size_t i, int which) -> const Estimate& {
+    return which == 1 ? backward[i] : again_estimates[i];
+  };
   std::size_t k = 0;
   int differ = 0;
   while (k < forward.size()) {
@@ -167,7 +168,6 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     const Estimate& e = again_estimates[k];
     if (e.hypothesis != f.hypothesis) ++differ;
     const Estimate& b = backward[k];
-    candidate[k] = {&e, &b};
     if (b.status != TrackStatus::Lost) {
       const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
       node[k][1] = without_temporal(forward_again.score(b_here));
@@ -188,14 +188,10 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // estimates taken, at the same weight λT (a pose prior of zero velocity):
   // where the frame cannot tell the two apart (a flat gripper's tilt
   // mirror), the estimate that continues its neighbours' is taken.
-  Eigen::VectorXd sigma(config.space.dims());
-  sigma.head<kPoseDims>() = config.tracker.init_spread.head<kPoseDims>();
-  sigma.tail(sigma.size() - kPoseDims).setConstant(config.cost.temporal_joint_sigma_deg);
-  const bool wrap_rz = config.space.periodic.size() > 5 && config.space.periodic[5];
   const auto step = [&](std::size_t i, int from, int to) {
-    const Eigen::VectorXd& h = candidate[i][to]->hypothesis;
-    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate[i - 1][from]->hypothesis, h);
-    return lt * temporal_distance(h, before, sigma, wrap_rz);
+    const Eigen::VectorXd& h = candidate(i, to).hypothesis;
+    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate(i - 1, from).hypothesis, h);
+    return lt * forward_again.temporal_term(h, before);
   };
   std::vector<std::array<double, 2>> total(forward.size());
   std::vector<std::array<int, 2>> came(forward.size(), {0, 0});
@@ -220,7 +216,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
   for (std::size_t i = 0; i < forward.size(); ++i) {
     summary.from_backward += path[i];
-    two_pass_results.write(*candidate[i][path[i]]);
+    two_pass_results.write(candidate(i, path[i]));
   }
   two_pass_results.close();
   summary.frames = static_cast<int>(forward.size());
