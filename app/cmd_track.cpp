@@ -126,8 +126,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
                 << ", no two-pass table was written\n";
       return 130;
     }
-    std::fprintf(report, "two-pass: %d frames, %d taken from the backward pass (%d lost there), %.1f s -> %s\n",
-                 t.frames, t.from_backward, t.backward_lost, t.wall_s,
+    std::fprintf(report,
+                 "two-pass: %d frames, %d taken from the backward pass (%d lost there), orientations smoothed "
+                 "(%.2f deg on the mean), %.1f s -> %s\n",
+                 t.frames, t.from_backward, t.backward_lost, t.smoothing_change_deg, t.wall_s,
                  (opt.out_dir / "two_pass" / "estimates.csv").string().c_str());
   }
   return 0;

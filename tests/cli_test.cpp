@@ -1,6 +1,8 @@
 // The gtrack executable as a user runs it: exit codes and one-line errors.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "gtrack/model.hpp"
 
 namespace fs = std::filesystem;
 
@@ -442,19 +446,37 @@ TEST(Cli, TwoPassTakesEachFrameFromTheForwardOrTheBackwardTrack) {
   ASSERT_EQ(forward.size(), 13u);
   ASSERT_EQ(backward.size(), 13u);
   ASSERT_EQ(both.size(), 13u);
-  const auto pose = [](const std::vector<std::string>& row) {
-    return std::vector<std::string>(row.begin(), row.begin() + 13);  // frame and the 12 parameters
+  // Frame, position and joints; the orientation is smoothed over
+  // neighbouring frames ([tracker] two_pass_smoothing).
+  const auto position_and_joints = [](const std::vector<std::string>& row) {
+    std::vector<std::string> kept(row.begin(), row.begin() + 4);
+    kept.insert(kept.end(), row.begin() + 7, row.begin() + 13);
+    return kept;
+  };
+  const auto turn_deg = [](const std::vector<std::string>& a, const std::vector<std::string>& b) {
+    const auto rotation = [](const std::vector<std::string>& r) {
+      return Eigen::Quaterniond(gtrack::rotation_from_euler_deg(std::stod(r[4]), std::stod(r[5]), std::stod(r[6])));
+    };
+    return rotation(a).angularDistance(rotation(b)) * 180 / M_PI;
   };
   int from_backward = 0;
+  double smoothed_deg = 0;
   for (int i = 1; i <= 12; ++i) {
     // The backward track's rows are written as made: the last frame first.
     EXPECT_EQ(backward[i][0], forward[13 - i][0]);
     ASSERT_EQ(both[i][0], forward[i][0]);
     const auto& b = backward[13 - i];
-    const bool is_forward = pose(both[i]) == pose(forward[i]), is_backward = pose(both[i]) == pose(b);
+    const bool is_forward = position_and_joints(both[i]) == position_and_joints(forward[i]);
+    const bool is_backward = position_and_joints(both[i]) == position_and_joints(b);
     EXPECT_TRUE(is_forward || is_backward) << "frame " << both[i][0];
+    smoothed_deg += turn_deg(both[i], is_forward ? forward[i] : b) / 12;
     from_backward += is_backward && !is_forward;
   }
+  // The mean change the smoothing made, as printed (the files' angles have 4 decimals).
+  const auto said = r.output.find("orientations smoothed (");
+  ASSERT_NE(said, std::string::npos) << r.output;
+  EXPECT_NEAR(std::stod(r.output.substr(said + 23)), smoothed_deg, 0.01) << r.output;
+  EXPECT_GT(smoothed_deg, 0.01);
   EXPECT_NE(r.output.find("two-pass: 12 frames, " + std::to_string(from_backward) + " taken from the backward pass"),
             std::string::npos)
       << r.output;

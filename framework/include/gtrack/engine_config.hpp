@@ -164,6 +164,10 @@ struct TrackerConfig {
   // seen ones when that costs at most this much too (the track itself goes
   // on from the search's result). 0 = off (the paper's tracker).
   double unseen_joint_tolerance = 0.001;
+  // With --two-pass: the standard deviation, in frames of the table, of the
+  // Gaussian kernel the two-pass table's orientations are averaged with
+  // (docs/tracker.md, "Two passes over a recording"). 0 = none.
+  double two_pass_smoothing = 1.5;
   int progress_every = 50;               // frames between progress lines when stderr is not a terminal
   bool overlay = true;                   // write overlay.mp4
 };

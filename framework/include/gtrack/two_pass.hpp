@@ -35,6 +35,7 @@ struct TwoPassSummary {
   int from_backward = 0;  // of those, taken from the backward pass
   int backward_lost = 0;  // frames the backward pass reported lost
   double wall_s = 0;      // the backward pass, the forward run again and the choice
+  double smoothing_change_deg = 0;  // mean change of orientation made by [tracker] two_pass_smoothing
   bool cancelled = false; // interrupted: backward/ holds the frames done, no two-pass table is written
 };
 
@@ -47,5 +48,20 @@ struct TwoPassSummary {
 // InputError for a live camera (no recording to go back over).
 GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                                    const std::vector<Estimate>& forward);
+
+// The orientations of a table smoothed over neighbouring rows (the last
+// step of two_pass, with [tracker] two_pass_smoothing as `sigma`): around
+// each row, the rotations of the rows within 3 sigma, as rotation vectors
+// relative to the row's, are fitted by a straight line in the row index,
+// with Gaussian weights of standard deviation `sigma` rows; the row takes
+// the line's value. The scatter of single rows is averaged out, and a
+// steady turn is kept as it is, also where the window is one-sided (the
+// table's ends, next to lost rows). Lost rows neither take part nor change.
+// Each row is first taken as its symmetric equivalent nearest the previous
+// row's, so that like is fitted with like, and the result is given back in
+// the row's own equivalent. Position and joints are left as they are.
+// Returns the mean change of orientation (deg) over the rows changed;
+// sigma <= 0 changes nothing.
+GTRACK_API double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma);
 
 }  // namespace gtrack

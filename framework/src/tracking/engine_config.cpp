@@ -146,6 +146,7 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   c.refine_optimizer = t.choice_or("refine_optimizer", c.refine_optimizer, {"cmaes", "pso"});
   c.unseen_joint_tolerance =
       t.number_or("unseen_joint_tolerance", c.unseen_joint_tolerance, Range::closed(0.0, 1.0));
+  c.two_pass_smoothing = t.number_or("two_pass_smoothing", c.two_pass_smoothing, Range::closed(0.0, 100.0));
   c.progress_every = static_cast<int>(t.integer_or("progress_every", c.progress_every, Range::closed(1, 1e9)));
   c.overlay = t.boolean_or("overlay", c.overlay);
   return c;

@@ -1,11 +1,15 @@
 // The backward pass over a recorded sequence, and the two-pass table.
 #include "gtrack/two_pass.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <limits>
+#include <cmath>
 #include <map>
+#include <numbers>
+#include <optional>
 #include <set>
 #include <span>
 
@@ -54,6 +58,63 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 }  // namespace
+
+double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma) {
+  if (!(sigma > 0) || rows.empty()) return 0;
+  const std::size_t n = rows.size();
+  // Each row as its symmetric equivalent nearest the previous row's.
+  std::vector<Eigen::Quaterniond> q(n, Eigen::Quaterniond::Identity());
+  std::vector<bool> used(n, false);
+  std::vector<Eigen::VectorXd> aligned(n);
+  std::optional<std::size_t> previous;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (rows[i].status == TrackStatus::Lost) continue;
+    aligned[i] = previous ? detail::nearest_equivalent(model, rows[i].hypothesis, aligned[*previous]) : rows[i].hypothesis;
+    q[i] = Eigen::Quaterniond(rotation_from_euler_deg(aligned[i][3], aligned[i][4], aligned[i][5]));
+    used[i] = true;
+    previous = i;
+  }
+  const auto reach = static_cast<std::ptrdiff_t>(std::ceil(3 * sigma));
+  double change = 0;
+  int changed = 0;
+  std::vector<Eigen::VectorXd> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!used[i]) continue;
+    // The rows around, as rotation vectors relative to this one, fitted by
+    // a straight line in the row index (weighted least squares); the line's
+    // value here is the correction. A steady turn is kept as it is, also
+    // where the window is one-sided (the table's ends, next to lost rows).
+    double s0 = 0, s1 = 0, s2 = 0;
+    Eigen::Vector3d m0 = Eigen::Vector3d::Zero(), m1 = Eigen::Vector3d::Zero();
+    const auto c = static_cast<std::ptrdiff_t>(i);
+    for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, c - reach);
+         j <= std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(n) - 1, c + reach); ++j) {
+      if (!used[static_cast<std::size_t>(j)]) continue;
+      const double t = static_cast<double>(j - c);
+      const double w = std::exp(-0.5 * (t / sigma) * (t / sigma));
+      const Eigen::AngleAxisd d(q[i].conjugate() * q[static_cast<std::size_t>(j)]);
+      const Eigen::Vector3d v = d.angle() * d.axis();
+      s0 += w;
+      s1 += w * t;
+      s2 += w * t * t;
+      m0 += w * v;
+      m1 += w * t * v;
+    }
+    const double det = s0 * s2 - s1 * s1;
+    const Eigen::Vector3d a = det > 1e-9 * s0 * s0 ? Eigen::Vector3d((s2 * m0 - s1 * m1) / det) : Eigen::Vector3d(m0 / s0);
+    const Eigen::Quaterniond fitted = a.norm() > 0 ? q[i] * Eigen::Quaterniond(Eigen::AngleAxisd(a.norm(), a.normalized()))
+                                                  : q[i];
+    Eigen::VectorXd h = aligned[i];
+    h.segment<3>(3) = euler_deg_from_rotation(fitted.toRotationMatrix());
+    change += a.norm() * 180.0 / std::numbers::pi;
+    ++changed;
+    out[i] = detail::nearest_equivalent(model, h, rows[i].hypothesis);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (used[i]) rows[i].hypothesis = out[i];
+  }
+  return changed ? change / changed : 0;
+}
 
 TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                         const std::vector<Estimate>& forward) {
@@ -213,11 +274,18 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   std::vector<int> path(forward.size(), 0);
   path.back() = total.back()[1] < total.back()[0] ? 1 : 0;
   for (std::size_t i = forward.size() - 1; i > 0; --i) path[i - 1] = came[i][path[i]];
-  ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
+  std::vector<Estimate> taken;
+  taken.reserve(forward.size());
   for (std::size_t i = 0; i < forward.size(); ++i) {
     summary.from_backward += path[i];
-    two_pass_results.write(candidate(i, path[i]));
+    taken.push_back(candidate(i, path[i]));
   }
+  // Each frame's estimate still carries its search's own scatter, which
+  // the neighbouring frames' estimates average out; the orientation, the
+  // weakly seen part of it, is averaged over a few frames (docs/tracker.md).
+  summary.smoothing_change_deg = smooth_orientations(setup.model(), taken, config.tracker.two_pass_smoothing);
+  ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
+  for (const Estimate& e : taken) two_pass_results.write(e);
   two_pass_results.close();
   summary.frames = static_cast<int>(forward.size());
   summary.wall_s = seconds_since(start);
