@@ -113,6 +113,7 @@ class GTRACK_API CostEvaluator {
     outside_tolerance_ = tolerance > 0 ? tolerance : 0;
   }
   double outside_allowance() const { return outside_allowance_; }
+  double outside_tolerance() const { return outside_tolerance_; }
   // Whether the renderers' rim counts (PairCounts::rim) are used: the rim's
   // P\O pixels are never taken as hidden (see weighted_dice_distance).
   void set_use_rim(bool use) { use_rim_ = use; }

@@ -124,6 +124,11 @@ class GTRACK_API Tracker {
   // the same observation, occlusion allowance, temporal prediction and
   // stimulus state. Throws before the first frame.
   CostTerms score(const Eigen::VectorXd& hypothesis);
+  // The same, but with the occlusion allowance a track whose previous
+  // estimate was `previous` would have had on this frame (the model's whole
+  // area there against the observation's). The tracker's own allowance is
+  // left as it was.
+  CostTerms score_after(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& previous);
   // T of a configuration against another taken as the prediction (the
   // temporal term's spreads, rz wrapped as the search space wraps it),
   // without changing the tracker's own prediction.

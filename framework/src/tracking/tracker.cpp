@@ -697,6 +697,19 @@ CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
   }
   return impl_->cost->evaluate_one(hypothesis);
 }
+CostTerms Tracker::score_after(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& previous) {
+  if (previous.size() != impl_->config.space.dims()) {
+    throw Error("tracker: score_after() got " + std::to_string(previous.size()) + " parameters for the previous "
+                "estimate, the model has " + std::to_string(impl_->config.space.dims()));
+  }
+  auto& cost = *impl_->cost;
+  const double allowance = cost.outside_allowance(), tolerance = cost.outside_tolerance();
+  impl_->set_allowance(impl_->whole_area(previous, impl_->renderer->render_mask(previous)));
+  const CostTerms terms = score(hypothesis);
+  cost.set_outside_allowance(allowance, tolerance);
+  return terms;
+}
+
 double Tracker::temporal_term(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& prediction) const {
   return temporal_distance(hypothesis, prediction, impl_->temporal_sigma(), impl_->wraps_rz());
 }

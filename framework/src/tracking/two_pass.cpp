@@ -207,6 +207,9 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // Per frame, the costs of the two candidates (0 the forward estimate, 1
   // the backward one) on the forward run's conditions, temporal term aside.
   std::vector<std::array<double, 2>> node(forward.size(), {kNone, kNone});
+  // Per frame and candidate of the previous frame (the first index), the
+  // same costs with the allowance that candidate gives.
+  std::vector<std::array<std::array<double, 2>, 2>> edge(forward.size());
   std::vector<Estimate> again_estimates(forward.size());
   const auto candidate = [&](std::size_t i, int which) -> const Estimate& {
     return which == 1 ? backward[i] : again_estimates[i];
@@ -234,7 +237,23 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
       node[k][1] = without_temporal(forward_again.score(b_here));
     }
     if (e.status != TrackStatus::Lost || b.status == TrackStatus::Lost) node[k][0] = without_temporal(e.terms);
-    logger().debug("frame {}: two-pass: forward {:.4f}, backward {:.4f}", f.frame, node[k][0], node[k][1]);
+    // The same two, each with the occlusion allowance it would have had
+    // after either candidate of the previous frame (a path's own story):
+    // the forward track's allowance comes from its own previous estimate,
+    // and where that was wrong under an occluder it makes the right
+    // configuration pay for the area the wrong one did not have.
+    for (int to = 0; to < 2; ++to) {
+      for (int from = 0; from < 2; ++from) {
+        edge[k][from][to] = node[k][to];
+        if (k == 0 || node[k][to] == kNone || candidate(k - 1, from).status == TrackStatus::Lost) continue;
+        const Eigen::VectorXd h =
+            to == 0 ? e.hypothesis : detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
+        edge[k][from][to] = without_temporal(forward_again.score_after(h, candidate(k - 1, from).hypothesis));
+      }
+    }
+    logger().debug("frame {}: two-pass: forward {:.4f}, backward {:.4f}; after forward {:.4f} {:.4f}, after "
+                   "backward {:.4f} {:.4f}",
+                   f.frame, node[k][0], node[k][1], edge[k][0][0], edge[k][0][1], edge[k][1][0], edge[k][1][1]);
     ++k;
   }
   if (differ > 0) {
@@ -263,7 +282,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
       if (node[i][to] == kNone) continue;
       for (int from = 0; from < 2; ++from) {
         if (total[i - 1][from] == kNone) continue;
-        const double t = total[i - 1][from] + step(i, from, to) + node[i][to];
+        const double t = total[i - 1][from] + step(i, from, to) + edge[i][from][to];
         if (t < total[i][to]) {
           total[i][to] = t;
           came[i][to] = from;
