@@ -592,6 +592,32 @@ TEST(Tracker, ScoreRepeatsTheFramesCost) {
   EXPECT_THROW(tracker.score(e.hypothesis.head(8)), gtrack::Error);
 }
 
+// Tracker::score_after (the two-pass path): the allowance is the one a track
+// with that previous estimate would have had. After the track's own previous
+// estimate it repeats score(); after a previous estimate seen edge-on (a far
+// smaller area) the half-hidden truth gets no allowance and pays for its
+// hidden half; the tracker's own allowance is left as it was.
+TEST(Tracker, ScoreAfterTakesTheAllowanceOfAnotherPreviousEstimate) {
+  auto setup = make_setup();
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
+  tracker.set_estimate(truth);
+  tracker.process(scene(setup, truth, 1), 0, 0.0, 26.0);
+  const Eigen::VectorXd previous = tracker.last_estimate().value();
+  const auto e = tracker.process(half_covered(tracker, setup, truth, 2), 1, 1 / 30.0, 26.0);
+  ASSERT_GT(e.outside_allowance, 0.0);
+  const gtrack::CostTerms own = tracker.score(truth);
+  const gtrack::CostTerms after_own = tracker.score_after(truth, previous);
+  EXPECT_DOUBLE_EQ(after_own.total, own.total);
+  EXPECT_DOUBLE_EQ(after_own.dice, own.dice);
+  Eigen::VectorXd edge_on = previous;
+  edge_on[3] = 85;  // tilted nearly edge-on: its whole area is far below O's
+  const gtrack::CostTerms after_edge_on = tracker.score_after(truth, edge_on);
+  EXPECT_GT(after_edge_on.dice, own.dice + 0.1);
+  EXPECT_DOUBLE_EQ(tracker.score(truth).total, own.total);  // the tracker's own allowance is back
+  EXPECT_THROW(tracker.score_after(truth, previous.head(8)), gtrack::Error);
+}
+
 // [cost] occlusion_rim_px: under an occluder, a model larger than the truth
 // that covers what is visible spills within the budget's allowance; only the
 // rim, the ring just outside O, tells it from the truth.
