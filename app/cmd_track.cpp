@@ -152,7 +152,8 @@ GTRACK_COMMAND(
           "no-overlay", "do not write the overlay video")(
           "two-pass",
           "after the run, track the recording again backwards and write OUT/two_pass/estimates.csv: per frame, "
-          "the forward or the backward estimate, chosen over the sequence by their costs and continuity")(
+          "the forward or the backward estimate, chosen over the sequence by their costs and continuity, "
+          "orientations smoothed over neighbouring frames ([tracker] two_pass_smoothing)")(
           "resume", "continue the run whose files are in OUT after its last finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
           "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(

@@ -8,12 +8,15 @@
 // frames in reverse order, from its own coarse search on the last frame.
 // The forward run is then tracked again (the same seed: the same estimates),
 // and each frame's backward estimate is scored beside its forward one, on
-// the forward track's observation, occlusion allowance and stimulus state,
-// as --score-truth scores a reference (Tracker::score). The two-pass table
+// the forward track's observation and stimulus state, as --score-truth
+// scores a reference, with the occlusion allowance that each candidate of
+// the previous frame gives (Tracker::score_after). The two-pass table
 // takes, over the whole sequence, the path through the two candidates that
 // minimises their costs (temporal term aside) plus the temporal term's
-// distance between consecutive estimates at the same weight λT.
-// docs/tracker.md, "Two passes over a recording", has the figures.
+// distance between consecutive estimates at the same weight λT; its
+// orientations are then smoothed over neighbouring frames
+// (smooth_orientations, below). docs/tracker.md, "Two passes over a
+// recording", has the figures.
 //
 // The stimulus plugin's state is that of the forward run at the frame (the
 // readings up to it replayed into a fresh instance of the plugin), so the
