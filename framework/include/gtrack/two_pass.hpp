@@ -54,7 +54,7 @@ GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& confi
 
 // The orientations of a table smoothed over neighbouring rows (the last
 // step of two_pass, with [tracker] two_pass_smoothing as `sigma`): around
-// each row, the rotations of the rows within 3 sigma, as rotation vectors
+// each row, the rotations of the rows within ceil(3 sigma), as rotation vectors
 // relative to the row's, are fitted by a straight line in the row index,
 // with Gaussian weights of standard deviation `sigma` rows; the row takes
 // the line's value. The scatter of single rows is averaged out, and a
@@ -63,8 +63,9 @@ GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& confi
 // Each row is first taken as its symmetric equivalent nearest the previous
 // row's, so that like is fitted with like, and the result is given back in
 // the row's own equivalent. Position and joints are left as they are.
-// Returns the mean change of orientation (deg) over the rows changed;
-// sigma <= 0 changes nothing.
+// Returns the mean change of orientation (deg) over the rows that are not
+// lost; sigma <= 0 changes nothing. `sigma` counts rows of the table: with
+// `--every K`, K times as many frames of the input.
 GTRACK_API double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma);
 
 }  // namespace gtrack

@@ -698,9 +698,14 @@ CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
   return impl_->cost->evaluate_one(hypothesis);
 }
 CostTerms Tracker::score_after(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& previous) {
-  if (previous.size() != impl_->config.space.dims()) {
-    throw Error("tracker: score_after() got " + std::to_string(previous.size()) + " parameters for the previous "
-                "estimate, the model has " + std::to_string(impl_->config.space.dims()));
+  if (!impl_->started) throw Error("tracker: score_after() needs a processed frame");
+  const auto dims = impl_->config.space.dims();
+  for (const auto* h : {&hypothesis, &previous}) {
+    if (h->size() != dims) {
+      throw Error("tracker: score_after() got " + std::to_string(h->size()) + " parameters for the " +
+                  (h == &previous ? "previous estimate" : "configuration") + ", the model has " +
+                  std::to_string(dims));
+    }
   }
   auto& cost = *impl_->cost;
   const double allowance = cost.outside_allowance(), tolerance = cost.outside_tolerance();

@@ -193,9 +193,9 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
 
   // The forward run again (the same tracker, seed and stimulus: the same
   // estimates), each backward estimate scored beside it as --score-truth
-  // scores a reference. The forward track's observation, allowance and
-  // stimulus state are the ones its search had its full chance on: a
-  // backward estimate that scores lower there is one that search missed.
+  // scores a reference: on the forward track's observation and stimulus
+  // state, which its search had its full chance on, and (below) with the
+  // occlusion allowance each candidate of the previous frame gives.
   Setup again = setup;
   again.stimulus = back.stimulus ? setup.loader->make_stimulus(setup.root.table("stimulus")) : nullptr;
   Tracker forward_again(again, config);
@@ -238,7 +238,10 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     }
     if (e.status != TrackStatus::Lost || b.status == TrackStatus::Lost) node[k][0] = without_temporal(e.terms);
     // The same two, each with the occlusion allowance it would have had
-    // after either candidate of the previous frame (a path's own story):
+    // after either candidate of the previous frame as reported (a path's
+    // own story; the forward candidate's reported joints of unseen fingers
+    // are filled in, so after it the forward estimate may score a little
+    // differently from its own search's allowance):
     // the forward track's allowance comes from its own previous estimate,
     // and where that was wrong under an occluder it makes the right
     // configuration pay for the area the wrong one did not have.
