@@ -459,6 +459,12 @@ TEST(Cli, TwoPassTakesEachFrameFromTheForwardOrTheBackwardTrack) {
     };
     return rotation(a).angularDistance(rotation(b)) * 180 / M_PI;
   };
+  std::vector<std::string> both_jsonl{""};  // 1-based like the CSV rows
+  {
+    std::ifstream jsonl(dir / "out" / "two_pass" / "estimates.jsonl");
+    for (std::string l; std::getline(jsonl, l);) both_jsonl.push_back(l);
+  }
+  ASSERT_EQ(both_jsonl.size(), 13u);
   int from_backward = 0;
   double smoothed_deg = 0;
   for (int i = 1; i <= 12; ++i) {
@@ -469,8 +475,12 @@ TEST(Cli, TwoPassTakesEachFrameFromTheForwardOrTheBackwardTrack) {
     const bool is_forward = position_and_joints(both[i]) == position_and_joints(forward[i]);
     const bool is_backward = position_and_joints(both[i]) == position_and_joints(b);
     EXPECT_TRUE(is_forward || is_backward) << "frame " << both[i][0];
-    smoothed_deg += turn_deg(both[i], is_forward ? forward[i] : b) / 12;
-    from_backward += is_backward && !is_forward;
+    // The table's .jsonl names the pass the row was taken from.
+    const bool named_forward = both_jsonl[i].find("\"two_pass\":\"forward\"") != std::string::npos;
+    const bool named_backward = both_jsonl[i].find("\"two_pass\":\"backward\"") != std::string::npos;
+    EXPECT_TRUE(named_forward ? is_forward : named_backward && is_backward) << both_jsonl[i];
+    smoothed_deg += turn_deg(both[i], named_forward ? forward[i] : b) / 12;
+    from_backward += named_backward;
   }
   // The mean change the smoothing made, as printed (the files' angles have 4 decimals).
   const auto said = r.output.find("orientations smoothed (");

@@ -123,4 +123,39 @@ TEST(SmoothOrientations, LeavesASmoothTrackAndAZeroSigmaAlone) {
   }
 }
 
+TEST(SmoothOrientations, ARowTheImageBarelySupportsCountsLittle) {
+  auto gripper = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& model = gripper->model();
+  std::vector<Eigen::VectorXd> truth;
+  for (int i = 0; i < 60; ++i) truth.push_back(truth_at(i));
+  // Row 30 is 25 deg off in its tilt; every row overlaps the observation
+  // by 4000 pixels, row 30 by `overlap_30`.
+  const auto smoothed = [&](std::uint64_t overlap_30) {
+    std::vector<Eigen::VectorXd> hs = truth;
+    hs[30][3] += 25;
+    auto rows = rows_of(hs);
+    for (auto& r : rows) r.terms.overlap = 4000;
+    rows[30].terms.overlap = overlap_30;
+    gtrack::smooth_orientations(model, rows, 1.5);
+    std::vector<double> error;
+    for (int i = 0; i < 60; ++i) {
+      error.push_back(angle_deg(rows[static_cast<std::size_t>(i)].hypothesis, truth[static_cast<std::size_t>(i)]));
+    }
+    return error;
+  };
+  // Seen as well as its neighbours, it keeps part of its error and passes
+  // some to them.
+  const auto alike = smoothed(4000);
+  EXPECT_GT(alike[30], 4.0);
+  EXPECT_GT(alike[29], 2.0);
+  EXPECT_GT(alike[31], 2.0);
+  // A sliver (2 % of the others' overlap): it takes its neighbours' line,
+  // and they keep theirs.
+  const auto sliver = smoothed(80);
+  EXPECT_LT(sliver[30], 0.5);
+  for (int i = 0; i < 60; ++i) {
+    if (i != 30) EXPECT_LT(sliver[static_cast<std::size_t>(i)], 0.2) << i;
+  }
+}
+
 }  // namespace

@@ -83,6 +83,9 @@ struct Estimate {
   // frame exactly as the estimate was: same observation, allowance,
   // temporal prediction and stimulus.
   std::optional<CostTerms> reference_terms;
+  // In the two-pass table (gtrack/two_pass.hpp): the pass the row was taken
+  // from, "forward" or "backward" ("two_pass" in estimates.jsonl).
+  std::string two_pass_source;
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
 };

@@ -122,6 +122,7 @@ std::string estimate_json(const Estimate& e) {
          ",\"rendered_pixels\":" + std::to_string(r->rendered) +
          ",\"overlap_pixels\":" + std::to_string(r->overlap) + ",\"rim_pixels\":" + std::to_string(r->rim) + "}";
   }
+  if (!e.two_pass_source.empty()) j += ",\"two_pass\":\"" + e.two_pass_source + "\"";
   j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") + "}";
   return j;
 }

@@ -74,7 +74,26 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
     used[i] = true;
     previous = i;
   }
+  // How much of the image each row rests on: its overlap with the
+  // observation, |R&O|, against the table's 90th percentile (a row seen
+  // whole and unoccluded), within [kLeast, 1]. A sliver at the image's
+  // border or a gripper mostly under an occluder holds its orientation
+  // weakly: its weight in the fits is multiplied by the cube of its
+  // support, and its own orientation comes mostly from its neighbours'.
+  constexpr double kLeast = 0.05;
   const auto reach = static_cast<std::ptrdiff_t>(std::ceil(3 * sigma));
+  std::vector<double> overlaps;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (used[i]) overlaps.push_back(static_cast<double>(rows[i].terms.overlap));
+  }
+  if (overlaps.empty()) return 0;
+  const auto p90 = overlaps.begin() + static_cast<std::ptrdiff_t>(0.9 * static_cast<double>(overlaps.size() - 1));
+  std::nth_element(overlaps.begin(), p90, overlaps.end());
+  const double full = *p90;
+  std::vector<double> support(n, 1.0);  // rows without their overlap (full = 0): all alike
+  for (std::size_t i = 0; i < n && full > 0; ++i) {
+    if (used[i]) support[i] = std::clamp(static_cast<double>(rows[i].terms.overlap) / full, kLeast, 1.0);
+  }
   double change = 0;
   int changed = 0;
   std::vector<Eigen::VectorXd> out(n);
@@ -91,7 +110,8 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
          j <= std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(n) - 1, c + reach); ++j) {
       if (!used[static_cast<std::size_t>(j)]) continue;
       const double t = static_cast<double>(j - c);
-      const double w = std::exp(-0.5 * (t / sigma) * (t / sigma));
+      const double u = support[static_cast<std::size_t>(j)];
+      const double w = std::exp(-0.5 * (t / sigma) * (t / sigma)) * u * u * u;
       const Eigen::AngleAxisd d(q[i].conjugate() * q[static_cast<std::size_t>(j)]);
       const Eigen::Vector3d v = d.angle() * d.axis();
       s0 += w;
@@ -301,6 +321,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   for (std::size_t i = 0; i < forward.size(); ++i) {
     summary.from_backward += path[i];
     taken.push_back(candidate(i, path[i]));
+    taken.back().two_pass_source = path[i] == 1 ? "backward" : "forward";
   }
   // Each frame's estimate still carries its search's own scatter, which
   // the neighbouring frames' estimates average out; the orientation, the
