@@ -57,9 +57,10 @@ GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& confi
 // each row, the rotations of the rows within ceil(3 sigma), as rotation
 // vectors relative to the row's, are fitted by a straight line in the row
 // index, with Gaussian weights of standard deviation `sigma` rows times
-// each row's support (below); the row takes the line's value. The scatter of single rows is averaged out, and a
-// steady turn is kept as it is, also where the window is one-sided (the
-// table's ends, next to lost rows). Lost rows neither take part nor change.
+// each row's support (below); the row takes the line's value. The scatter
+// of single rows is averaged out, and a steady turn is kept as it is, also
+// where the window is one-sided (the table's ends, next to lost rows).
+// Lost rows neither take part nor change.
 // Each row's support is its overlap with the observation (terms.overlap)
 // against the table's 90th percentile, within [0.05, 1], cubed: a sliver at
 // the image's border or a gripper mostly under an occluder takes its
