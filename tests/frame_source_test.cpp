@@ -1,11 +1,17 @@
-// Frame sources: the order of an image folder, and its ranges.
+// Frame sources: the order of an image folder, and its ranges; a recording
+// read again in blocks, backward (RecordedFrames).
 #include <gtest/gtest.h>
 #include <gtrack/frame_source.hpp>
 
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 #include <string>
 #include <vector>
+
+#include "gtrack/error.hpp"
 
 namespace fs = std::filesystem;
 
@@ -42,6 +48,113 @@ TEST(FrameSource, ARangeAndAStrideCountFromItsStart) {
   r.every = 2;
   auto src = gtrack::open_frame_source(dir.string(), {4, 4}, r, 30);
   EXPECT_EQ(names(*src), (std::vector<std::string>{"000001.png@1", "000003.png@3"}));
+}
+
+// A frame unlike its neighbours: noise drawn from its own seed, its number
+// written on it.
+cv::Mat numbered_frame(int i, int salt = 0) {
+  cv::Mat img(96, 128, CV_8UC3);
+  cv::RNG rng(static_cast<std::uint64_t>(1000 * salt + i + 1));
+  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(img, img, {7, 7}, 2);
+  cv::putText(img, std::to_string(i), {10, 60}, cv::FONT_HERSHEY_SIMPLEX, 1.5, {255, 255, 255}, 3);
+  return img;
+}
+
+// Writes `frames` frames; false when this OpenCV build has no such writer.
+bool write_video(const fs::path& path, int fourcc, int frames, int salt = 0) {
+  cv::VideoWriter w(path.string(), fourcc, 25, {128, 96});
+  if (!w.isOpened()) return false;
+  for (int i = 0; i < frames; ++i) w.write(numbered_frame(i, salt));
+  return true;
+}
+
+std::vector<cv::Mat> decoded_in_order(const fs::path& video) {
+  auto src = gtrack::open_frame_source(video.string(), {128, 96}, {}, 25);
+  std::vector<cv::Mat> out;
+  while (auto f = src->next()) {
+    EXPECT_EQ(f->index, static_cast<int>(out.size()));
+    out.push_back(f->image);
+  }
+  return out;
+}
+
+// The backward pass reads a recording a block at a time from its end: a
+// video's blocks are read by seeking, and must be the very frames reading
+// it in order gives, whatever the codec (intra-only MJPG; MPEG-4 with
+// frames predicted from earlier ones).
+TEST(RecordedFrames, AVideosBlocksReadFromItsEndAreTheFramesReadInOrder) {
+  const fs::path dir = folder_of("recorded_video", {});
+  struct Codec {
+    std::string file;
+    int fourcc;
+  };
+  int tried = 0;
+  for (const Codec& c : {Codec{"clip.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G')},
+                         Codec{"clip.mp4", cv::VideoWriter::fourcc('m', 'p', '4', 'v')}}) {
+    const fs::path video = dir / c.file;
+    if (!write_video(video, c.fourcc, 90)) continue;
+    ++tried;
+    const std::vector<cv::Mat> reference = decoded_in_order(video);
+    ASSERT_EQ(reference.size(), 90u) << c.file;
+    // Frames 7, 10, ..., 88 (--frames 7:89 --every 3), blocks of 5 from the end.
+    std::vector<int> frames;
+    for (int i = 7; i < 89; i += 3) frames.push_back(i);
+    gtrack::RecordedFrames recording(video.string(), {128, 96}, frames, 3, 25);
+    for (std::size_t hi = frames.size(); hi > 0; hi -= std::min<std::size_t>(hi, 5)) {
+      const std::size_t lo = hi - std::min<std::size_t>(hi, 5);
+      const auto block = recording.read(lo, hi);
+      ASSERT_EQ(block.size(), hi - lo) << c.file;
+      for (std::size_t k = lo; k < hi; ++k) {
+        const auto it = block.find(frames[k]);
+        ASSERT_NE(it, block.end()) << c.file << " frame " << frames[k];
+        EXPECT_EQ(cv::norm(it->second, reference[static_cast<std::size_t>(frames[k])], cv::NORM_INF), 0)
+            << c.file << " frame " << frames[k];
+      }
+    }
+    // Intra-only frames seek exactly: no block had to be decoded from the start.
+    if (c.file == "clip.avi") EXPECT_TRUE(recording.seeks());
+  }
+  ASSERT_GT(tried, 0) << "no video writer in this OpenCV build";
+}
+
+// A video replaced between two reads: the frame that differs is named,
+// rather than tracked as if it were the one the forward pass saw.
+TEST(RecordedFrames, AVideoThatChangedIsAnErrorNamingTheFrame) {
+  const fs::path dir = folder_of("recorded_changed", {});
+  const fs::path video = dir / "clip.avi";
+  ASSERT_TRUE(write_video(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 40)) << "no MJPG writer";
+  std::vector<int> frames(40);
+  for (int i = 0; i < 40; ++i) frames[static_cast<std::size_t>(i)] = i;
+  gtrack::RecordedFrames recording(video.string(), {128, 96}, frames, 1, 25);
+  EXPECT_EQ(recording.read(30, 40).size(), 10u);
+  ASSERT_TRUE(write_video(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 40, 1));
+  try {
+    recording.read(20, 30);
+    FAIL() << "a changed video was read as if it were the same";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 20 is no longer what it was"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(recording.seeks());
+}
+
+// A folder's blocks are its images by name; one removed since is named.
+TEST(RecordedFrames, AFoldersBlocksAreItsImagesAndAMissingOneIsNamed) {
+  const fs::path dir = folder_of("recorded_folder", {});
+  for (int i = 0; i < 12; ++i) cv::imwrite((dir / (std::to_string(i) + ".png")).string(), numbered_frame(i));
+  gtrack::RecordedFrames recording(dir.string(), {128, 96}, {2, 4, 6, 8, 10}, 2, 25);
+  const auto block = recording.read(3, 5);
+  ASSERT_EQ(block.size(), 2u);
+  EXPECT_EQ(cv::norm(block.at(10), numbered_frame(10), cv::NORM_INF), 0);
+  EXPECT_FALSE(recording.seeks());
+  fs::remove(dir / "11.png");
+  fs::remove(dir / "10.png");
+  try {
+    recording.read(3, 5);
+    FAIL() << "a removed image went unnoticed";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 10 can no longer be read"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
-// The two-pass table's orientation smoothing (gtrack::smooth_orientations)
-// against rotations computed here.
+// The two-pass table: its orientation smoothing (gtrack::smooth_orientations)
+// against rotations computed here, and its choice between the two passes'
+// estimates (gtrack::cheapest_path) against paths worked out by hand.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -156,6 +159,52 @@ TEST(SmoothOrientations, ARowTheImageBarelySupportsCountsLittle) {
   for (int i = 0; i < 60; ++i) {
     if (i != 30) EXPECT_LT(sliver[static_cast<std::size_t>(i)], 0.2) << i;
   }
+}
+
+// The two-pass table's choice between the forward (0) and backward (1)
+// candidates, against paths worked out by hand.
+using Costs = std::vector<std::array<std::array<double, 2>, 2>>;
+constexpr double kOut = std::numeric_limits<double>::infinity();
+
+TEST(CheapestPath, TakesTheCostOfEachCandidateAfterEachCandidateBefore) {
+  // Frame 0: forward 1.0, backward 1.5. Frame 1 after forward: 1.0 / 2.0;
+  // after backward: 2.0 / 0.1. Forward then forward sums 2.0, backward then
+  // backward 1.6: the path is {1, 1}. Reading frame 1's costs from one row
+  // only (each candidate's cost the same whatever came before) gives {0, 0}
+  // with the first row and {0, 1} with the second.
+  const Costs costs = {{{{1.0, 1.5}, {1.0, 1.5}}}, {{{1.0, 2.0}, {2.0, 0.1}}}};
+  EXPECT_EQ(gtrack::cheapest_path(costs), (std::vector<int>{1, 1}));
+  Costs row0 = costs, row1 = costs;
+  row0[1][1] = row0[1][0];
+  row1[1][0] = row1[1][1];
+  EXPECT_EQ(gtrack::cheapest_path(row0), (std::vector<int>{0, 0}));
+  EXPECT_EQ(gtrack::cheapest_path(row1), (std::vector<int>{0, 1}));
+}
+
+TEST(CheapestPath, PaysMoreAtOneFrameWhereTheFramesAfterRepayIt) {
+  // The backward candidate costs more at frames 0 and 1, but staying on the
+  // forward one costs 10 at frame 2 and switching costs 5 there: a frame by
+  // frame choice takes {0, 0, 1}, at 1 + 1 + 5; the path {1, 1, 1} costs 3.
+  const Costs costs = {
+      {{{1.0, 1.2}, {1.0, 1.2}}},
+      {{{1.0, 1.6}, {1.0, 1.2}}},
+      {{{10.0, 5.0}, {10.0, 0.6}}},
+  };
+  EXPECT_EQ(gtrack::cheapest_path(costs), (std::vector<int>{1, 1, 1}));
+}
+
+TEST(CheapestPath, LeavesOutWhatIsRuledOutAndTiesGoForward) {
+  // Frame 1 has no backward candidate (lost): every path goes through its
+  // forward one, although the backward candidates around it cost nothing.
+  const Costs costs = {
+      {{{1.0, 0.0}, {1.0, 0.0}}},
+      {{{0.5, kOut}, {3.0, kOut}}},
+      {{{1.0, 0.0}, {kOut, kOut}}},
+  };
+  EXPECT_EQ(gtrack::cheapest_path(costs), (std::vector<int>{0, 0, 1}));
+  const Costs tied = {{{{1.0, 1.0}, {1.0, 1.0}}}, {{{1.0, 1.0}, {1.0, 1.0}}}};
+  EXPECT_EQ(gtrack::cheapest_path(tied), (std::vector<int>{0, 0}));
+  EXPECT_TRUE(gtrack::cheapest_path(Costs{}).empty());
 }
 
 }  // namespace

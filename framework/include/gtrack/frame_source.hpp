@@ -9,11 +9,14 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "gtrack/export.hpp"
 #include "gtrack/sensor.hpp"
@@ -69,5 +72,42 @@ GTRACK_API std::unique_ptr<FrameSource> open_frame_source(const std::string& spe
 GTRACK_API std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSize expected,
                                                           FrameRange range, double fallback_fps,
                                                           const FollowOptions& follow);
+
+// The frames of a recording (a video file or a folder of images) read
+// again, a block at a time and in any order (the backward pass of
+// `--two-pass`). A folder's images are read by name. A video is decoded
+// once, in order, the first time a block does not start at the video's
+// first frame, and each frame's pixels fingerprinted; such blocks are then
+// read by seeking to their first frame and decoding from there, and
+// checked against those fingerprints. Seeking is not exact in
+// every video (B-frames, a variable frame rate): once a block read so is
+// not what reading in order gave, that block and every one after it are
+// decoded from the video's start, with a warning.
+class GTRACK_API RecordedFrames {
+ public:
+  // `frames`: the source indices that will be read again, ascending,
+  // `every` apart (the forward run's --frames and --every). InputError for
+  // a live camera and for what open_frame_source refuses.
+  RecordedFrames(std::string spec, ImageSize expected, std::vector<int> frames, int every, double fallback_fps);
+  // The images of frames[lo], ..., frames[hi - 1], by source index.
+  // InputError naming the frame when one can no longer be read, or (a
+  // video) is not the frame it was when the video was read in order.
+  std::map<int, cv::Mat> read(std::size_t lo, std::size_t hi);
+  // False once seeking has been found not to give the frames read in order
+  // (or for a folder, which has no need of it).
+  bool seeks() const { return video_ && seeks_; }
+
+ private:
+  void fingerprint_in_order();
+
+  std::string spec_;
+  ImageSize expected_;
+  std::vector<int> frames_;
+  int every_;
+  double fps_;
+  bool video_ = false;
+  bool seeks_ = true;
+  std::vector<std::uint64_t> prints_;  // per frame of frames_ (a video, once a block has needed them)
+};
 
 }  // namespace gtrack

@@ -25,6 +25,7 @@
 // backward).
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "gtrack/export.hpp"
@@ -73,5 +74,17 @@ GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& confi
 // lost; sigma <= 0 changes nothing. `sigma` counts rows of the table: with
 // `--every K`, K times as many frames of the input.
 GTRACK_API double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma);
+
+// The choice between two candidates per frame (0 the forward estimate, 1
+// the backward one), over a whole table: costs[i][from][to] is the cost of
+// taking candidate `to` at frame i after candidate `from` at frame i - 1
+// (in two_pass: its cost with the occlusion allowance `from` gives, plus
+// the temporal distance between the two); at the first frame only
+// costs[0][0] is read. An infinite cost rules the candidate, or the step,
+// out. Returns, per frame, the candidate of the path whose summed cost is
+// least (dynamic programming over the whole table: a candidate that costs
+// more at one frame is taken when the frames after it repay it); ties go
+// to the forward candidate.
+GTRACK_API std::vector<int> cheapest_path(const std::vector<std::array<std::array<double, 2>, 2>>& costs);
 
 }  // namespace gtrack

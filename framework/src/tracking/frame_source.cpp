@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
+#include <functional>
+#include <string_view>
 #include <thread>
 #include <chrono>
 #include <opencv2/imgcodecs.hpp>
@@ -56,13 +59,24 @@ class RangeFilter {
 
 class VideoSource final : public FrameSource {
  public:
+  // `seek`: the video is positioned at the range's first frame by seeking
+  // instead of decoding every frame before it. Seeking is not exact in
+  // every video (B-frames, a variable frame rate): only RecordedFrames,
+  // which checks what it reads against the frames read in order, asks
+  // for it.
   VideoSource(cv::VideoCapture cap, std::string name, ImageSize expected, FrameRange range, double fallback_fps,
-              bool live)
+              bool live, bool seek = false)
       : cap_(std::move(cap)), name_(std::move(name)), expected_(expected), filter_(range), live_(live) {
     fps_ = cap_.get(cv::CAP_PROP_FPS);
     if (!(fps_ > 0 && fps_ < 1e4)) fps_ = fallback_fps;
     count_ = live ? -1 : static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_COUNT));
     if (count_ <= 0 && !live) count_ = -1;
+    if (seek && !live && range.first > 0) {
+      detail::CapturedStderr library;
+      if (cap_.set(cv::CAP_PROP_POS_FRAMES, range.first)) index_ = range.first;
+      const std::string said = library.take();
+      if (!said.empty()) logger().debug("{}: seeking to frame {}, the decoder said: {}", name_, range.first, said);
+    }
   }
 
   std::optional<Frame> next() override {
@@ -272,7 +286,98 @@ class FolderSource final : public FrameSource {
   int index_ = 0;
 };
 
+std::unique_ptr<FrameSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
+                                        double fallback_fps, bool seek) {
+  cv::VideoCapture cap;
+  // FFmpeg alone when it is there: the other backends print pages of
+  // warnings for an undecodable file, and the error below says it in a line.
+  const bool ffmpeg = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG);
+  bool opened = false;
+  std::string said;
+  {
+    detail::CapturedStderr library;  // released before the source seeks, which captures its own
+    opened = cap.open(spec, ffmpeg ? cv::CAP_FFMPEG : cv::CAP_ANY) && cap.isOpened();
+    said = library.take();
+  }
+  if (!opened) {
+    throw InputError(spec + ": cannot open as a video (corrupt or unsupported format" +
+                     (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
+  }
+  if (!said.empty()) logger().debug("{}: the decoder said: {}", spec, said);
+  return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, false, seek);
+}
+
+// What a frame's pixels were, to tell whether a frame read again is the same.
+std::uint64_t fingerprint(const cv::Mat& image) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (int r = 0; r < image.rows; ++r) {
+    const std::string_view row(reinterpret_cast<const char*>(image.ptr(r)), image.cols * image.elemSize());
+    h = (h ^ std::hash<std::string_view>{}(row)) * 1099511628211ull;
+  }
+  return h;
+}
+
 }  // namespace
+
+RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector<int> frames, int every,
+                               double fallback_fps)
+    : spec_(std::move(spec)), expected_(expected), frames_(std::move(frames)), every_(std::max(1, every)),
+      fps_(fallback_fps) {
+  if (spec_.rfind("camera:", 0) == 0) throw InputError(spec_ + ": a live camera cannot be read again");
+  std::error_code ec;
+  video_ = !fs::is_directory(spec_, ec);
+}
+
+void RecordedFrames::fingerprint_in_order() {
+  auto source = open_video(spec_, expected_, {frames_.front(), frames_.back() + 1, every_}, fps_, false);
+  prints_.assign(frames_.size(), 0);
+  std::size_t k = 0;
+  while (auto f = source->next()) {
+    while (k < frames_.size() && frames_[k] < f->index) ++k;
+    if (k < frames_.size() && frames_[k] == f->index) prints_[k] = fingerprint(f->image);
+  }
+}
+
+std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
+  hi = std::min(hi, frames_.size());
+  if (lo >= hi) return {};
+  const FrameRange range{frames_[lo], frames_[hi - 1] + 1, every_};
+  const auto decode = [&](bool seek) {
+    auto source = video_ ? open_video(spec_, expected_, range, fps_, seek)
+                         : open_frame_source(spec_, expected_, range, fps_);
+    std::map<int, cv::Mat> images;
+    while (auto f = source->next()) images[f->index] = std::move(f->image);
+    return images;
+  };
+  // The first of [lo, hi) that is missing or not what it was, or hi.
+  const auto first_wrong = [&](const std::map<int, cv::Mat>& images) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      const auto it = images.find(frames_[k]);
+      if (it == images.end() || (!prints_.empty() && fingerprint(it->second) != prints_[k])) return k;
+    }
+    return hi;
+  };
+  if (video_ && seeks_ && range.first > 0) {
+    // The frames as the video gives them in order, once, the first time a
+    // block does not start at the video's first frame.
+    if (prints_.empty()) fingerprint_in_order();
+    auto images = decode(true);
+    if (first_wrong(images) == hi) return images;
+    seeks_ = false;
+    logger().warn("{}: seeking in the video does not give the frames that reading it in order does; each block is "
+                  "decoded from the video's start (slower)",
+                  spec_);
+  }
+  auto images = decode(false);
+  const std::size_t k = first_wrong(images);
+  if (k < hi) {
+    const bool missing = images.find(frames_[k]) == images.end();
+    throw InputError(spec_ + ": frame " + std::to_string(frames_[k]) +
+                     (missing ? " can no longer be read" : " is no longer what it was when it was first read") +
+                     "; the same input is needed again");
+  }
+  return images;
+}
 
 FrameRange parse_frame_range(const std::string& text) {
   FrameRange r;
@@ -332,19 +437,7 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   std::error_code ec;
   if (!fs::exists(p, ec)) throw InputError(spec + ": no such file or folder");
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
-  cv::VideoCapture cap;
-  // FFmpeg alone when it is there: the other backends print pages of
-  // warnings for an undecodable file, and the error below says it in a line.
-  const bool ffmpeg = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG);
-  detail::CapturedStderr library;
-  const bool opened = cap.open(spec, ffmpeg ? cv::CAP_FFMPEG : cv::CAP_ANY) && cap.isOpened();
-  const std::string said = library.take();
-  if (!opened) {
-    throw InputError(spec + ": cannot open as a video (corrupt or unsupported format" +
-                     (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
-  }
-  if (!said.empty()) logger().debug("{}: the decoder said: {}", spec, said);
-  return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, false);
+  return open_video(spec, expected, range, fallback_fps, false);
 }
 
 }  // namespace gtrack

@@ -10,7 +10,6 @@
 #include <map>
 #include <numbers>
 #include <optional>
-#include <set>
 #include <span>
 
 #include "gtrack/error.hpp"
@@ -136,6 +135,32 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
   return changed ? change / changed : 0;
 }
 
+std::vector<int> cheapest_path(const std::vector<std::array<std::array<double, 2>, 2>>& costs) {
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  const std::size_t n = costs.size();
+  if (n == 0) return {};
+  // total[i][c]: the least cost of a path ending in candidate c at frame i;
+  // came[i][c]: the candidate of frame i - 1 it came from.
+  std::vector<std::array<double, 2>> total(n, {kNone, kNone});
+  std::vector<std::array<int, 2>> came(n, {0, 0});
+  total[0] = costs[0][0];
+  for (std::size_t i = 1; i < n; ++i) {
+    for (int to = 0; to < 2; ++to) {
+      for (int from = 0; from < 2; ++from) {
+        const double t = total[i - 1][from] + costs[i][from][to];
+        if (t < total[i][to]) {
+          total[i][to] = t;
+          came[i][to] = from;
+        }
+      }
+    }
+  }
+  std::vector<int> path(n, 0);
+  path.back() = total.back()[1] < total.back()[0] ? 1 : 0;
+  for (std::size_t i = n - 1; i > 0; --i) path[i - 1] = came[i][path[i]];
+  return path;
+}
+
 TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                         const std::vector<Estimate>& forward) {
   const auto start = std::chrono::steady_clock::now();
@@ -170,36 +195,30 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
                 forward.front().frame);
   std::vector<Estimate> backward(forward.size());
   const int n = static_cast<int>(forward.size());
-  // Frames are read a block at a time, forward within the block (a video
-  // is decoded again from its start for each block: blocks are as large as
-  // about 512 MB of frames allows).
+  // Frames are read a block at a time, forward within the block, as many
+  // as about 512 MB of images allows (a video: by seeking to the block's
+  // first frame, checked against the frames read in order).
   const ImageSize size = setup.sensor->image_size();
   const double frame_bytes = 3.0 * std::max(1, size.width) * std::max(1, size.height);
   const int kBlock = std::clamp(static_cast<int>(512e6 / frame_bytes), 16, 4096);
   const int every = std::max(1, options.range.every);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : 30.0;
+  std::vector<int> indices;
+  indices.reserve(forward.size());
+  for (const Estimate& f : forward) indices.push_back(f.frame);
+  RecordedFrames recording(options.input, size, indices, every, fps);
   for (int hi = n; hi > 0 && !summary.cancelled; hi -= kBlock) {
     const int lo = std::max(0, hi - kBlock);
-    std::set<int> wanted;
-    for (int k = lo; k < hi; ++k) wanted.insert(forward[static_cast<std::size_t>(k)].frame);
-    auto source = open_frame_source(options.input, size, FrameRange{*wanted.begin(), *wanted.rbegin() + 1, every}, fps);
-    std::map<int, cv::Mat> images;
-    while (auto f = source->next()) {
-      if (wanted.count(f->index)) images[f->index] = std::move(f->image);
-    }
+    const std::map<int, cv::Mat> images = recording.read(static_cast<std::size_t>(lo), static_cast<std::size_t>(hi));
     for (int k = hi - 1; k >= lo; --k) {
       if (options.cancel && options.cancel->load()) {
         summary.cancelled = true;
         break;
       }
       const Estimate& f = forward[static_cast<std::size_t>(k)];
-      const auto image = images.find(f.frame);
-      if (image == images.end()) {
-        throw InputError(options.input + ": frame " + std::to_string(f.frame) +
-                         " of the forward run can no longer be read; the backward pass needs the same input");
-      }
+      const cv::Mat& image = images.at(f.frame);
       if (replay) replay->seek(forward, static_cast<std::size_t>(k));
-      Estimate b = tracker.process(image->second, f.frame, f.time_s, f.stimulus);
+      Estimate b = tracker.process(image, f.frame, f.time_s, f.stimulus);
       backward_results.write(b);
       if (b.status == TrackStatus::Lost) ++summary.backward_lost;
       backward[static_cast<std::size_t>(k)] = std::move(b);
@@ -296,26 +315,16 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate(i - 1, from).hypothesis, h);
     return lt * forward_again.temporal_term(h, before);
   };
-  std::vector<std::array<double, 2>> total(forward.size());
-  std::vector<std::array<int, 2>> came(forward.size(), {0, 0});
-  total[0] = node[0];
-  for (std::size_t i = 1; i < forward.size(); ++i) {
-    for (int to = 0; to < 2; ++to) {
-      total[i][to] = kNone;
-      if (node[i][to] == kNone) continue;
-      for (int from = 0; from < 2; ++from) {
-        if (total[i - 1][from] == kNone) continue;
-        const double t = total[i - 1][from] + step(i, from, to) + edge[i][from][to];
-        if (t < total[i][to]) {
-          total[i][to] = t;
-          came[i][to] = from;
-        }
+  std::vector<std::array<std::array<double, 2>, 2>> costs(forward.size());
+  for (std::size_t i = 0; i < forward.size(); ++i) {
+    for (int from = 0; from < 2; ++from) {
+      for (int to = 0; to < 2; ++to) {
+        const bool out = node[i][to] == kNone || (i > 0 && node[i - 1][from] == kNone);
+        costs[i][from][to] = out ? kNone : edge[i][from][to] + (i > 0 ? step(i, from, to) : 0.0);
       }
     }
   }
-  std::vector<int> path(forward.size(), 0);
-  path.back() = total.back()[1] < total.back()[0] ? 1 : 0;
-  for (std::size_t i = forward.size() - 1; i > 0; --i) path[i - 1] = came[i][path[i]];
+  const std::vector<int> path = cheapest_path(costs);
   std::vector<Estimate> taken;
   taken.reserve(forward.size());
   for (std::size_t i = 0; i < forward.size(); ++i) {
