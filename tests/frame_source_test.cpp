@@ -112,14 +112,16 @@ TEST(RecordedFrames, AVideosBlocksReadFromItsEndAreTheFramesReadInOrder) {
             << c.file << " frame " << frames[k];
       }
     }
-    // Intra-only frames seek exactly: no block had to be decoded from the start.
+    // The first block is read with the pass that fingerprints the video;
+    // the five after it by seeking. Intra-only frames seek exactly.
     if (c.file == "clip.avi") EXPECT_TRUE(recording.seeks());
+    if (recording.seeks()) EXPECT_EQ(recording.seeked_blocks(), 5) << c.file;
   }
   ASSERT_GT(tried, 0) << "no video writer in this OpenCV build";
 }
 
 // A video replaced between two reads: the frame that differs is named,
-// rather than tracked as if it were the one the forward pass saw.
+// rather than tracked as if it were the one this reader first decoded.
 TEST(RecordedFrames, AVideoThatChangedIsAnErrorNamingTheFrame) {
   const fs::path dir = folder_of("recorded_changed", {});
   const fs::path video = dir / "clip.avi";
@@ -135,10 +137,11 @@ TEST(RecordedFrames, AVideoThatChangedIsAnErrorNamingTheFrame) {
   } catch (const gtrack::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("frame 20 is no longer what it was"), std::string::npos) << e.what();
   }
-  EXPECT_FALSE(recording.seeks());
+  EXPECT_EQ(recording.seeked_blocks(), 0);
 }
 
-// A folder's blocks are its images by name; one removed since is named.
+// A folder's blocks are its images by their place in name order; a frame
+// past the folder's end since is named.
 TEST(RecordedFrames, AFoldersBlocksAreItsImagesAndAMissingOneIsNamed) {
   const fs::path dir = folder_of("recorded_folder", {});
   for (int i = 0; i < 12; ++i) cv::imwrite((dir / (std::to_string(i) + ".png")).string(), numbered_frame(i));

@@ -75,30 +75,36 @@ GTRACK_API std::unique_ptr<FrameSource> open_frame_source(const std::string& spe
 
 // The frames of a recording (a video file or a folder of images) read
 // again, a block at a time and in any order (the backward pass of
-// `--two-pass`). A folder's images are read by name. A video is decoded
-// once, in order, the first time a block does not start at the video's
-// first frame, and each frame's pixels fingerprinted; such blocks are then
-// read by seeking to their first frame and decoding from there, and
-// checked against those fingerprints. Seeking is not exact in
-// every video (B-frames, a variable frame rate): once a block read so is
-// not what reading in order gave, that block and every one after it are
-// decoded from the video's start, with a warning.
+// `--two-pass`). A folder's images are read by their place in name order,
+// as open_frame_source numbers them (an image removed since shifts the
+// ones after it; only frames past the folder's end are noticed). A video
+// is decoded once, in order, the first time a block does not start at the
+// video's first frame (that block is read so), and each frame's pixels
+// fingerprinted; later such blocks are read by seeking to their first
+// frame and decoding from there, and checked against those fingerprints.
+// Seeking is not exact in every video (B-frames, a variable frame rate):
+// once a block read so is not what reading in order gave, that block and
+// every one after it are decoded from the video's start, with a warning.
 class GTRACK_API RecordedFrames {
  public:
-  // `frames`: the source indices that will be read again, ascending,
-  // `every` apart (the forward run's --frames and --every). InputError for
-  // a live camera and for what open_frame_source refuses.
+  // `frames`: the source indices that will be read again, ascending and
+  // `every` apart (the forward run's --frames and --every;
+  // std::invalid_argument otherwise). InputError for a live camera.
   RecordedFrames(std::string spec, ImageSize expected, std::vector<int> frames, int every, double fallback_fps);
   // The images of frames[lo], ..., frames[hi - 1], by source index.
   // InputError naming the frame when one can no longer be read, or (a
-  // video) is not the frame it was when the video was read in order.
+  // video) is not the frame it was when this reader decoded it in order,
+  // and for what open_frame_source refuses.
   std::map<int, cv::Mat> read(std::size_t lo, std::size_t hi);
   // False once seeking has been found not to give the frames read in order
   // (or for a folder, which has no need of it).
   bool seeks() const { return video_ && seeks_; }
+  // Blocks read by seeking (the decoder took the seek and the frames were
+  // the ones read in order).
+  int seeked_blocks() const { return seeked_blocks_; }
 
  private:
-  void fingerprint_in_order();
+  std::map<int, cv::Mat> fingerprint_in_order(std::size_t lo, std::size_t hi);
 
   std::string spec_;
   ImageSize expected_;
@@ -107,6 +113,7 @@ class GTRACK_API RecordedFrames {
   double fps_;
   bool video_ = false;
   bool seeks_ = true;
+  int seeked_blocks_ = 0;
   std::vector<std::uint64_t> prints_;  // per frame of frames_ (a video, once a block has needed them)
 };
 

@@ -84,7 +84,8 @@ GTRACK_API double smooth_orientations(const ArticulatedModel& model, std::vector
 // out. Returns, per frame, the candidate of the path whose summed cost is
 // least (dynamic programming over the whole table: a candidate that costs
 // more at one frame is taken when the frames after it repay it); ties go
-// to the forward candidate.
+// to the forward candidate, as does every frame where each path is ruled
+// out.
 GTRACK_API std::vector<int> cheapest_path(const std::vector<std::array<std::array<double, 2>, 2>>& costs);
 
 }  // namespace gtrack

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string_view>
 #include <thread>
 #include <chrono>
@@ -73,7 +74,10 @@ class VideoSource final : public FrameSource {
     if (count_ <= 0 && !live) count_ = -1;
     if (seek && !live && range.first > 0) {
       detail::CapturedStderr library;
-      if (cap_.set(cv::CAP_PROP_POS_FRAMES, range.first)) index_ = range.first;
+      if (cap_.set(cv::CAP_PROP_POS_FRAMES, range.first)) {
+        index_ = range.first;
+        seeked_ = true;
+      }
       const std::string said = library.take();
       if (!said.empty()) logger().debug("{}: seeking to frame {}, the decoder said: {}", name_, range.first, said);
     }
@@ -102,6 +106,8 @@ class VideoSource final : public FrameSource {
   double fps() const override { return fps_; }
   int frame_count() const override { return count_; }
   std::string description() const override { return name_; }
+  // Whether the source was positioned by seeking (`seek`, and the decoder took it).
+  bool seeked() const { return seeked_; }
 
  private:
   std::optional<Frame> end_of_stream() {
@@ -120,6 +126,7 @@ class VideoSource final : public FrameSource {
   int count_ = -1;
   int index_ = 0;
   int delivered_ = 0;
+  bool seeked_ = false;
 };
 
 // Name order with runs of digits compared as numbers ("img2" < "img10");
@@ -286,8 +293,10 @@ class FolderSource final : public FrameSource {
   int index_ = 0;
 };
 
-std::unique_ptr<FrameSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
+std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
                                         double fallback_fps, bool seek) {
+  std::error_code ec;
+  if (!fs::exists(spec, ec)) throw InputError(spec + ": no such file or folder");
   cv::VideoCapture cap;
   // FFmpeg alone when it is there: the other backends print pages of
   // warnings for an undecodable file, and the error below says it in a line.
@@ -324,31 +333,34 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
     : spec_(std::move(spec)), expected_(expected), frames_(std::move(frames)), every_(std::max(1, every)),
       fps_(fallback_fps) {
   if (spec_.rfind("camera:", 0) == 0) throw InputError(spec_ + ": a live camera cannot be read again");
+  for (std::size_t k = 1; k < frames_.size(); ++k) {
+    if (frames_[k] - frames_[k - 1] != every_) {
+      throw std::invalid_argument("RecordedFrames: frames " + std::to_string(frames_[k - 1]) + " and " +
+                                  std::to_string(frames_[k]) + " are not " + std::to_string(every_) + " apart");
+    }
+  }
   std::error_code ec;
   video_ = !fs::is_directory(spec_, ec);
 }
 
-void RecordedFrames::fingerprint_in_order() {
+std::map<int, cv::Mat> RecordedFrames::fingerprint_in_order(std::size_t lo, std::size_t hi) {
   auto source = open_video(spec_, expected_, {frames_.front(), frames_.back() + 1, every_}, fps_, false);
-  prints_.assign(frames_.size(), 0);
-  std::size_t k = 0;
+  std::vector<std::uint64_t> prints(frames_.size(), 0);
+  std::map<int, cv::Mat> block;
   while (auto f = source->next()) {
-    while (k < frames_.size() && frames_[k] < f->index) ++k;
-    if (k < frames_.size() && frames_[k] == f->index) prints_[k] = fingerprint(f->image);
+    const std::size_t k = static_cast<std::size_t>((f->index - frames_.front()) / every_);
+    if (k >= frames_.size()) break;
+    prints[k] = fingerprint(f->image);
+    if (k >= lo && k < hi) block[f->index] = std::move(f->image);
   }
+  prints_ = std::move(prints);
+  return block;
 }
 
 std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
   hi = std::min(hi, frames_.size());
   if (lo >= hi) return {};
   const FrameRange range{frames_[lo], frames_[hi - 1] + 1, every_};
-  const auto decode = [&](bool seek) {
-    auto source = video_ ? open_video(spec_, expected_, range, fps_, seek)
-                         : open_frame_source(spec_, expected_, range, fps_);
-    std::map<int, cv::Mat> images;
-    while (auto f = source->next()) images[f->index] = std::move(f->image);
-    return images;
-  };
   // The first of [lo, hi) that is missing or not what it was, or hi.
   const auto first_wrong = [&](const std::map<int, cv::Mat>& images) {
     for (std::size_t k = lo; k < hi; ++k) {
@@ -357,24 +369,47 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
     }
     return hi;
   };
+  const auto all_there = [&](const std::map<int, cv::Mat>& images) {
+    return std::all_of(frames_.begin() + static_cast<std::ptrdiff_t>(lo),
+                       frames_.begin() + static_cast<std::ptrdiff_t>(hi),
+                       [&](int f) { return images.count(f) > 0; });
+  };
+  bool seek_failed = false;
   if (video_ && seeks_ && range.first > 0) {
-    // The frames as the video gives them in order, once, the first time a
-    // block does not start at the video's first frame.
-    if (prints_.empty()) fingerprint_in_order();
-    auto images = decode(true);
-    if (first_wrong(images) == hi) return images;
-    seeks_ = false;
-    logger().warn("{}: seeking in the video does not give the frames that reading it in order does; each block is "
-                  "decoded from the video's start (slower)",
-                  spec_);
+    // The first time a block does not start at the video's first frame,
+    // the video is decoded once in order: that block is read so, and every
+    // frame fingerprinted for the blocks after it.
+    if (prints_.empty()) {
+      auto images = fingerprint_in_order(lo, hi);
+      if (all_there(images)) return images;
+    } else {
+      auto source = open_video(spec_, expected_, range, fps_, true);
+      std::map<int, cv::Mat> images;
+      while (auto f = source->next()) images[f->index] = std::move(f->image);
+      if (first_wrong(images) == hi) {
+        if (source->seeked()) ++seeked_blocks_;
+        return images;
+      }
+      seek_failed = true;
+    }
   }
-  auto images = decode(false);
+  std::map<int, cv::Mat> images;
+  {
+    auto source = open_frame_source(spec_, expected_, range, fps_);
+    while (auto f = source->next()) images[f->index] = std::move(f->image);
+  }
   const std::size_t k = first_wrong(images);
   if (k < hi) {
     const bool missing = images.find(frames_[k]) == images.end();
     throw InputError(spec_ + ": frame " + std::to_string(frames_[k]) +
-                     (missing ? " can no longer be read" : " is no longer what it was when it was first read") +
+                     (missing ? " can no longer be read" : " is no longer what it was when this pass first read it") +
                      "; the same input is needed again");
+  }
+  if (seek_failed) {
+    seeks_ = false;
+    logger().warn("{}: seeking in the video does not give the frames that reading it in order does; each block is "
+                  "decoded from the video's start (slower)",
+                  spec_);
   }
   return images;
 }
