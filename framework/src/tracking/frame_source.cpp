@@ -369,10 +369,10 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
     }
     return hi;
   };
-  const auto all_there = [&](const std::map<int, cv::Mat>& images) {
-    return std::all_of(frames_.begin() + static_cast<std::ptrdiff_t>(lo),
-                       frames_.begin() + static_cast<std::ptrdiff_t>(hi),
-                       [&](int f) { return images.count(f) > 0; });
+  const auto collect = [](FrameSource& source) {
+    std::map<int, cv::Mat> images;
+    while (auto f = source.next()) images[f->index] = std::move(f->image);
+    return images;
   };
   bool seek_failed = false;
   if (video_ && seeks_ && range.first > 0) {
@@ -381,11 +381,10 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
     // frame fingerprinted for the blocks after it.
     if (prints_.empty()) {
       auto images = fingerprint_in_order(lo, hi);
-      if (all_there(images)) return images;
+      if (first_wrong(images) == hi) return images;
     } else {
       auto source = open_video(spec_, expected_, range, fps_, true);
-      std::map<int, cv::Mat> images;
-      while (auto f = source->next()) images[f->index] = std::move(f->image);
+      auto images = collect(*source);
       if (first_wrong(images) == hi) {
         if (source->seeked()) ++seeked_blocks_;
         return images;
@@ -393,11 +392,7 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
       seek_failed = true;
     }
   }
-  std::map<int, cv::Mat> images;
-  {
-    auto source = open_frame_source(spec_, expected_, range, fps_);
-    while (auto f = source->next()) images[f->index] = std::move(f->image);
-  }
+  auto images = collect(*open_frame_source(spec_, expected_, range, fps_));
   const std::size_t k = first_wrong(images);
   if (k < hi) {
     const bool missing = images.find(frames_[k]) == images.end();
@@ -470,9 +465,8 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   }
   const fs::path p(spec);
   std::error_code ec;
-  if (!fs::exists(p, ec)) throw InputError(spec + ": no such file or folder");
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
-  return open_video(spec, expected, range, fallback_fps, false);
+  return open_video(spec, expected, range, fallback_fps, false);  // a missing path: "no such file or folder"
 }
 
 }  // namespace gtrack
