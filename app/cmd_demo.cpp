@@ -83,8 +83,7 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
             << std::setprecision(1) << "  phalanx endpoints " << e.endpoint_um.mean << " +- " << e.endpoint_um.std
             << " um\n"
             << "two passes (offline: the recording also tracked backwards, " << both.from_backward << " of "
-            << both.frames << " frames taken from the backward track, orientations "
-            << (cfg.tracker.two_pass_smoothing > 0 ? "smoothed over neighbouring frames" : "not smoothed") << "; "
+            << both.frames << " frames taken from the backward track, " << gtrack::smoothing_report(both) << "; "
             << both.wall_s << " s):\n"
             << "  position in-plane " << ev2.in_view.position_inplane_um.mean << " um, orientation "
             << std::setprecision(2) << ev2.in_view.orientation_deg.mean << " deg, joints "

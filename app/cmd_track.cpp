@@ -126,12 +126,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
                 << ", no two-pass table was written\n";
       return 130;
     }
-    char smoothed[96] = "orientations not smoothed";
-    if (config.tracker.two_pass_smoothing > 0) {
-      std::snprintf(smoothed, sizeof smoothed, "orientations smoothed (%.2f deg on the mean)", t.smoothing_change_deg);
-    }
     std::fprintf(report, "two-pass: %d frames, %d taken from the backward pass (%d lost there), %s, %.1f s -> %s\n",
-                 t.frames, t.from_backward, t.backward_lost, smoothed, t.wall_s,
+                 t.frames, t.from_backward, t.backward_lost, gtrack::smoothing_report(t).c_str(), t.wall_s,
                  (opt.out_dir / "two_pass" / "estimates.csv").string().c_str());
   }
   return 0;

@@ -26,6 +26,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "gtrack/export.hpp"
@@ -39,7 +40,8 @@ struct TwoPassSummary {
   int from_backward = 0;  // of those, taken from the backward pass
   int backward_lost = 0;  // frames the backward pass reported lost
   double wall_s = 0;      // the backward pass, the forward run again and the choice
-  double smoothing_change_deg = 0;  // mean change of orientation made by [tracker] two_pass_smoothing
+  bool smoothed = false;            // [tracker] two_pass_smoothing > 0
+  double smoothing_change_deg = 0;  // mean change of orientation made by the smoothing
   bool cancelled = false; // interrupted: backward/ holds the frames done, no two-pass table is written
 };
 
@@ -50,6 +52,10 @@ struct TwoPassSummary {
 // two_pass/estimates.csv and .jsonl (frame order, once both passes are
 // done). The tracker's time is about three times the forward run's.
 // InputError for a live camera (no recording to go back over).
+// For reports: "orientations smoothed (0.52 deg on the mean)" or
+// "orientations not smoothed".
+GTRACK_API std::string smoothing_report(const TwoPassSummary& summary);
+
 GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                                    const std::vector<Estimate>& forward);
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <limits>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -57,6 +58,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 }  // namespace
+
+std::string smoothing_report(const TwoPassSummary& summary) {
+  if (!summary.smoothed) return "orientations not smoothed";
+  char text[80];
+  std::snprintf(text, sizeof text, "orientations smoothed (%.2f deg on the mean)", summary.smoothing_change_deg);
+  return text;
+}
 
 double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma) {
   if (!(sigma > 0) || rows.empty()) return 0;
@@ -335,6 +343,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // Each frame's estimate still carries its search's own scatter, which
   // the neighbouring frames' estimates average out; the orientation, the
   // weakly seen part of it, is averaged over a few frames (docs/tracker.md).
+  summary.smoothed = config.tracker.two_pass_smoothing > 0;
   summary.smoothing_change_deg = smooth_orientations(setup.model(), taken, config.tracker.two_pass_smoothing);
   ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
   for (const Estimate& e : taken) two_pass_results.write(e);
