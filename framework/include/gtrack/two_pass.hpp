@@ -52,12 +52,12 @@ struct TwoPassSummary {
 // two_pass/estimates.csv and .jsonl (frame order, once both passes are
 // done). The tracker's time is about three times the forward run's.
 // InputError for a live camera (no recording to go back over).
+GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
+                                   const std::vector<Estimate>& forward);
+
 // For reports: "orientations smoothed (0.52 deg on the mean)" or
 // "orientations not smoothed".
 GTRACK_API std::string smoothing_report(const TwoPassSummary& summary);
-
-GTRACK_API TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
-                                   const std::vector<Estimate>& forward);
 
 // The orientations of a table smoothed over neighbouring rows (the last
 // step of two_pass, with [tracker] two_pass_smoothing as `sigma`): around
