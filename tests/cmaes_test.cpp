@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "gtrack/cmaes.hpp"
 #include "gtrack/error.hpp"
@@ -51,6 +52,23 @@ TEST(Cmaes, SphereConvergesFromAnOffsetMean) {
   for (std::size_t g = 1; g < r.best_cost_per_generation.size(); ++g) {
     EXPECT_LE(r.best_cost_per_generation[g], r.best_cost_per_generation[g - 1]);
   }
+}
+
+// Costs that are not numbers (x0 > 0, where the search starts) rank last: it
+// still finds the finite part and converges there.
+TEST(Cmaes, CostsThatAreNotNumbersRankLast) {
+  std::mt19937_64 rng(7);
+  gtrack::CmaesOptions o;
+  o.generations = 120;
+  const auto f = [](const Eigen::VectorXd& x) {
+    return x[0] > 0.0 ? std::numeric_limits<double>::quiet_NaN() : (x.array() + 1.0).square().sum();
+  };
+  const auto r = gtrack::cmaes_minimize(Eigen::VectorXd::Constant(6, 2.0), Eigen::VectorXd::Ones(6), cube(6, 5.12), o,
+                                        batch(f), rng);
+  ASSERT_TRUE(std::isfinite(r.best_cost));
+  EXPECT_LT(r.best_cost, 1e-6);
+  EXPECT_LE(r.best[0], 0.0);
+  EXPECT_NEAR(r.best[0], -1.0, 1e-3);
 }
 
 TEST(Cmaes, LearnsARotatedValleyTheSwarmDoesNot) {

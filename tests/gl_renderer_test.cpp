@@ -361,6 +361,61 @@ TEST(GlRenderer, BatchesOfAnySizeMatchOneAtATime) {
   }
 }
 
+// A batch larger than the render target's memory budget is drawn and
+// counted in chunks: the counts are those of one draw, exactly. 1 MiB holds
+// 4 layers of 256x256, 128 hypotheses.
+TEST(GlRenderer, ABatchBeyondTheTargetBudgetIsCountedInChunks) {
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(300, 5, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(8));
+  std::vector<PairCounts> whole, chunked;
+  {
+    GL_OR_SKIP(gl);
+    gl->set_model(s.model);
+    gl->set_projection(s.projection, kScale);
+    gl->set_observation(s.observation);
+    gl->evaluate(H, whole);
+  }
+  ScopedEnv budget("GTRACK_GL_TARGET_MB", "1");
+  GL_OR_SKIP(gl);
+  gl->set_model(s.model);
+  gl->set_projection(s.projection, kScale);
+  gl->set_observation(s.observation);
+  for (int n : {300, 128, 129, 257, 40}) {
+    gl->evaluate(H.leftCols(n), chunked);
+    ASSERT_EQ(chunked.size(), static_cast<size_t>(n));
+    int overlapping = 0;
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(chunked[i].rendered, whole[i].rendered) << "batch " << n << ", hypothesis " << i;
+      EXPECT_EQ(chunked[i].intersection, whole[i].intersection) << "batch " << n << ", hypothesis " << i;
+      EXPECT_EQ(chunked[i].rim, whole[i].rim) << "batch " << n << ", hypothesis " << i;
+      overlapping += whole[i].intersection > 0;
+    }
+    EXPECT_GT(overlapping, 0) << "batch " << n;
+  }
+  ScopedEnv bad("GTRACK_GL_TARGET_MB", "0");
+  EXPECT_THROW(gtrack::make_gl_renderer({}), gtrack::Error);
+}
+
+// A gripper whose link table is smaller than the smallest buffer (two fingers
+// of one link: 8 bytes) renders as the cpu backend does.
+TEST(GlRenderer, AgreesWithCpuOnATwoFingerOneLinkGripper) {
+  GL_OR_SKIP(gl);
+  gtrack::RadialGripperSpec spec;
+  spec.name = "two_single_links";
+  spec.fingers = 2;
+  spec.palm_sides = 4;
+  spec.palm_circumradius_mm = 0.5;
+  spec.links.push_back({0.6, 0.5, 0.3});
+  gtrack::GripperGeometry g = gtrack::make_radial_gripper(spec);
+  g.joint_min_deg = -10;
+  g.joint_max_deg = 120;
+  Scene s{ArticulatedModel(g), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(64, 21, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(6));
+  expect_agreement(*gl, s, H, 8);
+}
+
 // The render target keeps the layers of the largest batch: a smaller batch
 // after it, and a mask, see nothing of what the larger one drew there.
 TEST(GlRenderer, ABatchAfterALargerOneSeesNothingOfIt) {

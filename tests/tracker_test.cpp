@@ -320,6 +320,19 @@ TEST(Tracker, NothingDetectedIsLostNotAnError) {
   EXPECT_EQ(e.hypothesis, pose(0.3, -0.2, 20, 5));  // held
 }
 
+// `initial_pose` starts the first frame that shows the gripper, also when
+// frames before it showed nothing: the track starts there (status tracked),
+// not from a coarse search.
+TEST(Tracker, InitialPoseOutlastsEmptyFirstFrames) {
+  auto setup = make_setup("[tracker]\ninitial_pose = [0.1, 0.1, 100.0, 8, -6, 10, 10, 10, 10, 10, 10, 10]\n");
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  const cv::Mat empty(256, 256, CV_8UC3, cv::Scalar(120, 125, 130));
+  for (int i = 0; i < 2; ++i) EXPECT_EQ(tracker.process(empty, i, 0.1 * i, std::nullopt).status, gtrack::TrackStatus::Lost);
+  const auto e = tracker.process(scene(setup, pose(0.1, 0.1, 10, 10), 3), 2, 0.2, std::nullopt);
+  EXPECT_EQ(e.status, gtrack::TrackStatus::Tracked);
+  EXPECT_LT((e.hypothesis.head<2>() - pose(0.1, 0.1, 10, 10).head<2>()).norm(), 0.1);
+}
+
 TEST(Tracker, SameSeedSameEstimates) {
   auto setup = make_setup();
   const auto config = gtrack::engine_config(setup);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <string>
@@ -23,6 +24,7 @@ constexpr int kLayerBits = 32;         // hypotheses per R32UI layer
 constexpr int kCountGroupWidth = 32;   // columns per count workgroup
 constexpr int kMaxCountRows = 255;     // rows per count invocation: the most count.comp allows
 constexpr int kCountsPerHypothesis = 3;  // |O & P|, |P|, |R & P|, as count.comp writes them
+constexpr long kDefaultTargetMiB = 256;  // the render target's most memory, GTRACK_GL_TARGET_MB
 static_assert(kMaxCountRows * kCountGroupWidth <= 0xFFFF, "a workgroup's counts must fit the 16-bit halves");
 
 // Rows per count invocation. A CPU driver (llvmpipe) runs few threads and
@@ -42,6 +44,21 @@ int count_rows_for(const std::string& renderer) {
                    renderer.find("SwiftShader") != std::string::npos;
   return cpu ? kMaxCountRows : 32;
 }
+
+// The render target's memory budget, in MiB. A batch that needs more layers
+// than the budget (or the driver) allows is drawn and counted in chunks.
+// GTRACK_GL_TARGET_MB overrides the default.
+long target_budget_mib() {
+  if (const char* env = std::getenv("GTRACK_GL_TARGET_MB"); env && *env) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (*end != '\0' || v < 1 || v > 1'000'000) {
+      throw Error(std::string("GTRACK_GL_TARGET_MB='") + env + "': expected a whole number of MiB from 1 to 1000000");
+    }
+    return v;
+  }
+  return kDefaultTargetMiB;
+}
 constexpr int kMaxClipPlanes = 4;
 
 // Binding points shared with the shaders.
@@ -51,10 +68,19 @@ static_assert(sizeof(ModelVertex) == 16, "ModelVertex must match the std430 Mesh
 
 int layers_for(int hypotheses) { return (hypotheses + kLayerBits - 1) / kLayerBits; }
 
+// A buffer of at least 16 bytes (empty storage is not allowed), of which the
+// first `bytes` come from `data` when given; nothing past them is read.
 GLuint make_buffer(const Api& gl, GLsizeiptr bytes, const void* data, GLbitfield flags) {
   GLuint b = 0;
   gl.CreateBuffers(1, &b);
-  gl.NamedBufferStorage(b, std::max<GLsizeiptr>(bytes, 16), data, flags);
+  const GLsizeiptr size = std::max<GLsizeiptr>(bytes, 16);
+  if (data == nullptr || size == bytes) {
+    gl.NamedBufferStorage(b, size, data, flags);
+  } else {
+    std::vector<unsigned char> padded(static_cast<size_t>(size), 0);
+    if (bytes > 0) std::memcpy(padded.data(), data, static_cast<size_t>(bytes));
+    gl.NamedBufferStorage(b, size, padded.data(), flags);
+  }
   return b;
 }
 
@@ -107,6 +133,10 @@ GlRenderer::GlRenderer(const RenderOptions& options)
   }
 
   count_rows_ = count_rows_for(context_.gl_renderer());
+  target_budget_bytes_ = target_budget_mib() << 20;
+  GLint max_layers = 0;
+  gl_.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  max_layers_ = std::max(1, static_cast<int>(max_layers));
   const std::string head = prelude(layer_extension, count_rows_);
   draw_program_ = build_program(gl_, head, {{GL_VERTEX_SHADER, {"pose.glsl", "hypotheses.vert"}},
                                             {GL_FRAGMENT_SHADER, {"hypotheses.frag"}}});
@@ -256,7 +286,7 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
     target_ = 0;
     const int layers = layer_capacity_;
     layer_capacity_ = 0;
-    reserve_layers(std::max(1, layers));
+    reserve_layers(std::clamp(layers, 1, chunk_layers()));
     if (observation_ != 0) gl_.DeleteTextures(1, &observation_);
     gl_.CreateTextures(GL_TEXTURE_2D, 1, &observation_);
     gl_.TextureStorage2D(observation_, 1, GL_R8UI, w, h);
@@ -340,17 +370,23 @@ void GlRenderer::reserve_hypotheses(int count) {
   hypothesis_capacity_ = capacity;
 }
 
+int GlRenderer::chunk_layers() const {
+  const long layer_bytes = 4L * projection_.size.width * projection_.size.height;
+  const long by_memory = std::max(1L, target_budget_bytes_ / std::max(1L, layer_bytes));
+  return static_cast<int>(std::min<long>(max_layers_, by_memory));
+}
+
 void GlRenderer::reserve_layers(int layers) {
   // Grow-only: a batch smaller than the largest so far uses the first layers
   // of the target, and nothing is reallocated from one batch to the next.
+  // Doubling stops at the chunk size: submit() never asks for more.
   if (layers <= layer_capacity_ && target_ != 0) return;
-  GLint max_layers = 0;
-  gl_.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
-  if (layers > max_layers) {
-    throw Error("gl backend: " + std::to_string(layers * kLayerBits) + " hypotheses need " + std::to_string(layers) +
-                " layers, the driver allows " + std::to_string(max_layers));
+  const int cap = chunk_layers();
+  if (layers > cap) {
+    throw Error("gl backend: " + std::to_string(layers) + " layers asked of a render target that holds at most " +
+                std::to_string(cap));
   }
-  layers = std::min(std::max(layers, 2 * layer_capacity_), static_cast<int>(max_layers));
+  layers = std::min(std::max(layers, 2 * layer_capacity_), cap);
   layer_capacity_ = 0;  // nothing is reused if the reallocation below fails part way
   if (target_ != 0) gl_.DeleteTextures(1, &target_);
   gl_.CreateTextures(GL_TEXTURE_2D_ARRAY, 1, &target_);
@@ -387,6 +423,36 @@ void GlRenderer::draw(int count) {
   gl_.DrawArraysInstanced(GL_TRIANGLES, 0, vertices_, count);
 }
 
+void GlRenderer::submit_chunk(const Eigen::MatrixXd& hypotheses, int first, int m) {
+  const int layers = layers_for(m);
+  upload_hypotheses(hypotheses.col(first).data(), m);
+  static_assert(sizeof(PixelBox) == 4 * sizeof(GLint), "PixelBox must match the ivec4 boxes of count.comp");
+  boxes_.assign(static_cast<size_t>(layers), PixelBox{});
+  for (int i = 0; i < m; ++i) {
+    const Eigen::Vector3d centre = hypotheses.col(first + i).head<3>();
+    boxes_[static_cast<size_t>(i / kLayerBits)].unite(hypothesis_box(projection_, centre, reach_mm_));
+  }
+  int max_w = 0, max_h = 0;
+  for (const PixelBox& b : boxes_) {
+    max_w = std::max(max_w, b.width());
+    max_h = std::max(max_h, b.height());
+  }
+  gl_.NamedBufferSubData(box_buffer_, 0, GLsizeiptr(boxes_.size() * sizeof(PixelBox)), boxes_.data());
+
+  const GLsizeiptr count_bytes = GLsizeiptr(m) * kCountsPerHypothesis * GLsizeiptr(sizeof(std::uint32_t));
+  gl_.ClearNamedBufferSubData(count_buffer_, GL_R32UI, 0, count_bytes, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  draw(m);
+  if (max_w > 0 && max_h > 0) {
+    gl_.UseProgram(count_program_);
+    gl_.ProgramUniform1i(count_program_, u_hypotheses_, m);
+    gl_.DispatchCompute(GLuint((max_w + kCountGroupWidth - 1) / kCountGroupWidth),
+                        GLuint((max_h + count_rows_ - 1) / count_rows_), GLuint(layers));
+  }
+  gl_.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  const GLintptr offset = GLintptr(first) * kCountsPerHypothesis * GLintptr(sizeof(std::uint32_t));
+  gl_.CopyNamedBufferSubData(count_buffer_, readback_buffer_, 0, offset, count_bytes);
+}
+
 void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
   require_ready("submit()", hypotheses.rows());
   if (pending_ >= 0) throw Error("gl backend: submit() called again before finish()");
@@ -397,9 +463,12 @@ void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
     return;
   }
   reserve_hypotheses(n);
-  const int layers = layers_for(n);
-  reserve_layers(layers);
-  upload_hypotheses(hypotheses.data(), n);
+  // At most chunk_layers() layers are drawn at once: a larger batch (a wide
+  // coarse search) is drawn and counted chunk by chunk into the same target,
+  // each chunk's counts copied to its place in the read-back buffer, with one
+  // fence for all of them.
+  const int chunk = chunk_layers() * kLayerBits;
+  reserve_layers(layers_for(std::min(n, chunk)));
   if (texture_dirty_) {
     // No batch is pending (finish() waited for the last one): the texture
     // is free to change.
@@ -409,31 +478,10 @@ void GlRenderer::submit(const Eigen::MatrixXd& hypotheses) {
     gl_.check("uploading the observation");
     texture_dirty_ = false;
   }
-
-  static_assert(sizeof(PixelBox) == 4 * sizeof(GLint), "PixelBox must match the ivec4 boxes of count.comp");
-  boxes_.assign(static_cast<size_t>(layers), PixelBox{});
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d centre = hypotheses.col(i).head<3>();
-    boxes_[static_cast<size_t>(i / kLayerBits)].unite(hypothesis_box(projection_, centre, reach_mm_));
+  for (int first = 0; first < n; first += chunk) {
+    const int m = std::min(chunk, n - first);
+    submit_chunk(hypotheses, first, m);
   }
-  int max_w = 0, max_h = 0;
-  for (const PixelBox& b : boxes_) {
-    max_w = std::max(max_w, b.width());
-    max_h = std::max(max_h, b.height());
-  }
-  gl_.NamedBufferSubData(box_buffer_, 0, GLsizeiptr(boxes_.size() * sizeof(PixelBox)), boxes_.data());
-
-  const GLsizeiptr count_bytes = GLsizeiptr(n) * kCountsPerHypothesis * GLsizeiptr(sizeof(std::uint32_t));
-  gl_.ClearNamedBufferSubData(count_buffer_, GL_R32UI, 0, count_bytes, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-  draw(n);
-  if (max_w > 0 && max_h > 0) {
-    gl_.UseProgram(count_program_);
-    gl_.ProgramUniform1i(count_program_, u_hypotheses_, n);
-    gl_.DispatchCompute(GLuint((max_w + kCountGroupWidth - 1) / kCountGroupWidth),
-                        GLuint((max_h + count_rows_ - 1) / count_rows_), GLuint(layers));
-  }
-  gl_.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  gl_.CopyNamedBufferSubData(count_buffer_, readback_buffer_, 0, 0, count_bytes);
   fence_ = gl_.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
   // Start the work now: the caller computes its other cost terms meanwhile.
   gl_.Flush();

@@ -3,8 +3,9 @@
 // One generation of N hypotheses costs, on the GPU side: one buffer upload of
 // the parameter vectors (N x dims floats) and of the per-layer count boxes,
 // one instanced draw (instance = hypothesis; 32 hypotheses share an R32UI
-// layer, each its own bit, merged with the OR logic op), one compute dispatch
-// that reduces |O & P| and |P| per hypothesis, one 8 N-byte copy into a
+// layer, each its own bit, merged with the OR logic op; a batch larger than
+// the render target's memory budget is drawn in chunks), one compute dispatch
+// that reduces |O & P|, |P| and |R & P| per hypothesis, one 12 N-byte copy into a
 // persistently mapped buffer and one fence. submit() issues all of it and
 // returns; finish() waits on the fence once and reads the counts from the
 // mapping. The model, the projection and the observation stay on the GPU
@@ -45,6 +46,11 @@ class GlRenderer final : public Renderer {
   void require_ready(const char* what, Eigen::Index rows) const;
   void reserve_hypotheses(int count);
   void reserve_layers(int layers);
+  // Layers drawn at once: the driver's limit, or the memory budget's.
+  int chunk_layers() const;
+  // Draws and counts hypotheses first .. first+m-1 (at most chunk_layers()
+  // layers), their counts copied to their place in the read-back buffer.
+  void submit_chunk(const Eigen::MatrixXd& hypotheses, int first, int m);
   void upload_hypotheses(const double* data, int count);
   // Clears the target and draws hypotheses 0 .. count-1 into it.
   void draw(int count);
@@ -71,6 +77,8 @@ class GlRenderer final : public Renderer {
   int layer_capacity_ = 0;  // layers of target_: at least those of the largest batch so far
   int max_clip_planes_ = 0;
   int count_rows_ = 0;  // rows per count invocation (COUNT_ROWS of count.comp)
+  int max_layers_ = 1;  // GL_MAX_ARRAY_TEXTURE_LAYERS
+  long target_budget_bytes_ = 0;  // the render target's most memory (GTRACK_GL_TARGET_MB)
 
   int dims_ = 0;
   int vertices_ = 0;

@@ -58,6 +58,11 @@ PsoResult cmaes_minimize(const Eigen::VectorXd& mean, const Eigen::VectorXd& sca
     objective(x, cost);
     if (cost.size() != lambda) throw Error("cmaes_minimize: the objective returned the wrong number of costs");
     result.evaluations += static_cast<std::uint64_t>(lambda);
+    // As in the swarm: a cost that is not a number (a plugin's term gone
+    // wrong) ranks last instead of breaking the sort's order.
+    for (int k = 0; k < lambda; ++k) {
+      if (!std::isfinite(cost[k])) cost[k] = std::numeric_limits<double>::max();
+    }
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return cost[a] < cost[b]; });
     if (cost[order[0]] < result.best_cost) {

@@ -230,7 +230,9 @@ struct Tracker::Impl {
       };
       Eigen::VectorXd best;
       CostTerms terms;
-      if (searching && !started && config.tracker.initial_pose) {
+      // `initial_pose` starts the first frame that shows anything: until a
+      // configuration was found there is no `last`.
+      if (searching && !last && config.tracker.initial_pose) {
         best = optimise(*config.tracker.initial_pose, stimulus_on, rng);
         e.status = TrackStatus::Tracked;
         terms = score(best);
