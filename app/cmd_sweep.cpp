@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -13,6 +14,7 @@
 
 #include "command.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/plugin_loader.hpp"
 #include "gtrack/synth.hpp"
 #include "gtrack/synthetic_benchmark.hpp"
@@ -101,17 +103,45 @@ struct Context {
   int sequences = 1;
 };
 
+// What a cached sequence was made from: the config's text and the synth
+// options. A sequence is reused only when they are the same, so that a
+// sweep run again in the same --out with another config, preset or length
+// does not score the old sequences.
+std::string sequence_recipe(const Context& c, std::uint64_t seed, double noise) {
+  std::ifstream in(c.config, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  char line[256];
+  std::snprintf(line, sizeof line, "frames %d\npreset %s\nseed %llu\nnoise %.17g\nocclusion_scale %.17g\n",
+                c.synth.frames, c.synth.preset.c_str(), static_cast<unsigned long long>(seed), noise,
+                c.synth.occlusion_scale);
+  return "config " + fs::absolute(c.config).string() + "\nconfig_hash " +
+         std::to_string(std::hash<std::string>{}(text.str())) + "\n" + line;
+}
+
 fs::path make_sequence(const Context& c, std::uint64_t seed, double noise) {
   char name[64];
-  std::snprintf(name, sizeof name, "seq_seed%llu_noise%.2f", static_cast<unsigned long long>(seed), noise);
+  std::snprintf(name, sizeof name, "seq_seed%llu_noise%g", static_cast<unsigned long long>(seed), noise);
   const fs::path dir = c.out / "sequences" / name;
-  if (fs::exists(dir / "ground_truth.csv") && fs::exists(dir / "sequence.toml")) return dir;  // reuse
+  const fs::path stamp = dir / "made_from.txt";
+  const std::string recipe = sequence_recipe(c, seed, noise);
+  if (fs::exists(dir / "ground_truth.csv") && fs::exists(dir / "sequence.toml") && fs::exists(stamp)) {
+    std::ifstream in(stamp, std::ios::binary);
+    std::ostringstream had;
+    had << in.rdbuf();
+    if (had.str() == recipe) return dir;  // reuse
+  }
+  if (fs::exists(dir)) {
+    gtrack::logger().info("sweep: {} was made from other settings; making it again", dir.string());
+    fs::remove_all(dir);
+  }
   gtrack::SynthOptions o = c.synth;
   o.seed = seed;
   o.joint_noise_deg = noise;
   gtrack::SetupOptions so;
   so.plugin_paths = c.common.plugin_paths;
   gtrack::write_synthetic_sequence(gtrack::load_setup(c.config, so), o, dir);
+  std::ofstream(stamp, std::ios::binary) << recipe;
   return dir;
 }
 

@@ -239,6 +239,27 @@ TEST(Cli, SynthIntoAnEarlierSequenceLeavesOnlyItsOwnFrames) {
   EXPECT_TRUE(fs::exists(dir / "frames" / "notes.txt"));  // not a frame: left alone
 }
 
+// gtrack sweep writes both figures' tables and plots, one row per cell; run
+// again in the same folder with another sequence length, it makes its
+// sequences again instead of scoring the old ones.
+TEST(Cli, SweepWritesTheFiguresAndRemakesSequencesMadeOtherwise) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "sweep";
+  fs::remove_all(dir);
+  const std::string tiny = "sweep --particles 4,6 --generations 2 --sigmas 0,1 --fig6b-particles 4 "
+                           "--fig6b-generations 2 --out " + dir.string();
+  CliRun r = gtrack(tiny + " --frames 3");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f : {"fig6a.csv", "fig6a.png", "fig6b.csv", "fig6b.png"}) EXPECT_TRUE(fs::exists(dir / f)) << f;
+  EXPECT_EQ(lines(read_file(dir / "fig6a.csv")), 1 + 2);  // header, N = 4 and 6 at G = 2
+  EXPECT_EQ(lines(read_file(dir / "fig6b.csv")), 1 + 2);  // header, sigma 0 and 1
+  const fs::path truth = dir / "sequences" / "seq_seed1_noise1" / "ground_truth.csv";
+  const int rows3 = lines(read_file(truth));
+  r = gtrack(tiny + " --frames 5");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(lines(read_file(truth)), rows3 + 2);
+  EXPECT_EQ(count_files(dir / "sequences" / "seq_seed1_noise1" / "frames", ".png"), 5);
+}
+
 // A fresh run into the folder of an earlier one replaces it: no overlay,
 // mask or row of the earlier run is left beside the new results.
 TEST(Cli, TrackIntoAnEarlierRunReplacesIt) {

@@ -176,6 +176,24 @@ TEST(CpuRenderer, MasksEqualTheReferenceWithTiesOnTheTopView) {
 
 // padded_projection: the image's pixels are the padded canvas's, shifted by
 // the margin, and the canvas also holds what lies beyond the image's borders.
+// The render image covers the full image exactly, also when the scale does
+// not give a whole number of pixels: the far edges (1024, 662) land on the
+// rounded sizes (307, 199 at 0.3), as the observation is resized.
+TEST(CpuRenderer, ScaledProjectionMapsEdgeToEdge) {
+  const Projection full = microscope_projection(1024, 662, 4000, 4000, 512, 331, 0.1);
+  const Projection p = gtrack::scaled_projection(full, 0.3);
+  ASSERT_EQ(p.size.width, 307);
+  ASSERT_EQ(p.size.height, 199);
+  const double z = 50.0;
+  for (const auto& [u, v] : {std::pair{0.0, 0.0}, std::pair{1024.0, 662.0}, std::pair{512.0, 331.0}}) {
+    const Eigen::Vector4d X((u - 512) * z / 4000, (v - 331) * z / 4000, z, 1);
+    const Eigen::Vector3d full_h = full.world_to_image * X, small_h = p.world_to_image * X;
+    ASSERT_NEAR(full_h.x() / full_h.z(), u, 1e-9);
+    EXPECT_NEAR(small_h.x() / small_h.z(), u * 307 / 1024, 1e-9);
+    EXPECT_NEAR(small_h.y() / small_h.z(), v * 199 / 662, 1e-9);
+  }
+}
+
 TEST(CpuRenderer, PaddedProjectionExtendsTheImage) {
   const ArticulatedModel model(hydrogel_geometry());
   const Projection p = gtrack::scaled_projection(camera(), kScale);

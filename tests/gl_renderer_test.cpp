@@ -397,6 +397,25 @@ TEST(GlRenderer, ABatchBeyondTheTargetBudgetIsCountedInChunks) {
   EXPECT_THROW(gtrack::make_gl_renderer({}), gtrack::Error);
 }
 
+// A sensor may clip with up to 8 planes on either backend: a box around the
+// gripper's volume (the near plane and six faces) cuts many hypotheses.
+TEST(GlRenderer, AgreesWithCpuWithEightClipPlanes) {
+  GL_OR_SKIP(gl);
+  Projection p = camera();
+  p.clip_planes.emplace_back(1, 0, 0, 3.0);    // x >= -3
+  p.clip_planes.emplace_back(-1, 0, 0, 3.0);   // x <= 3
+  p.clip_planes.emplace_back(0, 1, 0, 2.5);    // y >= -2.5
+  p.clip_planes.emplace_back(0, -1, 0, 3.5);   // y <= 3.5
+  p.clip_planes.emplace_back(0, 0, 1, -36);    // z >= 36
+  p.clip_planes.emplace_back(0, 0, -1, 58);    // z <= 58
+  p.clip_planes.emplace_back(0.6, 0.8, 0, 3);  // an oblique face
+  ASSERT_EQ(p.clip_planes.size(), 8u);
+  Scene s{ArticulatedModel(hydrogel_geometry()), p, {}};
+  const Eigen::MatrixXd H = camera_hypotheses(64, 31, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(6));
+  expect_agreement(*gl, s, H, 8);
+}
+
 // A gripper whose link table is smaller than the smallest buffer (two fingers
 // of one link: 8 bytes) renders as the cpu backend does.
 TEST(GlRenderer, AgreesWithCpuOnATwoFingerOneLinkGripper) {

@@ -5,9 +5,9 @@
 //   - a 3x4 matrix taking world points (mm) to homogeneous image coordinates
 //     (u*w, v*w, w) in pixels of the full-resolution image (pixel centres at
 //     +0.5; a point is imaged when w > 0),
-//   - clip planes in world coordinates (n.x + d >= 0 is kept), at most 4 (the
-//     gl backend's limit): the pinhole's near plane, the ultrasound slab's
-//     two faces; none for an orthographic (telecentric) sensor.
+//   - clip planes in world coordinates (n.x + d >= 0 is kept), at most 8
+//     (both backends): the pinhole's near plane, the ultrasound slab's two
+//     faces; none for an orthographic (telecentric) sensor.
 // Both backends clip triangles against the planes, divide by w and fill with
 // the pixel-centre rule. project() is the full model (with lens distortion)
 // used for drawing overlays and for tests.

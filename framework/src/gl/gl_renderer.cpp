@@ -59,7 +59,7 @@ long target_budget_mib() {
   }
   return kDefaultTargetMiB;
 }
-constexpr int kMaxClipPlanes = 4;
+constexpr int kMaxClipPlanes = 8;  // GL_MAX_CLIP_DISTANCES is at least 8, as the cpu backend allows
 
 // Binding points shared with the shaders.
 enum Binding : GLuint { kMesh = 0, kFingers = 1, kLinks = 2, kHypotheses = 3, kBoxes = 4, kCounts = 5 };

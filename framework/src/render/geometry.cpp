@@ -121,10 +121,13 @@ void clip_triangle(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const E
 Projection scaled_projection(const Projection& projection, double scale) {
   if (!(scale > 0)) throw Error("render scale must be positive, got " + std::to_string(scale));
   Projection p = projection;
-  // Pixel edges sit on integers in both images, so scaling u and v is exact.
-  p.world_to_image.topRows<2>() *= scale;
   p.size.width = std::max(1, static_cast<int>(std::lround(scale * projection.size.width)));
   p.size.height = std::max(1, static_cast<int>(std::lround(scale * projection.size.height)));
+  // Pixel edges sit on integers in both images, so scaling u and v is exact.
+  // Each axis by the ratio of the rounded sizes, the ratio the observation is
+  // resized by: 1024 px at scale 0.3 is 307 render pixels, 0.2998 each.
+  p.world_to_image.row(0) *= static_cast<double>(p.size.width) / projection.size.width;
+  p.world_to_image.row(1) *= static_cast<double>(p.size.height) / projection.size.height;
   return p;
 }
 
