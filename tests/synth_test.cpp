@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <opencv2/imgproc.hpp>
 
 #include "gtrack/engine_config.hpp"
@@ -173,6 +176,49 @@ TEST(Synth, WritesAFolderThatATrackerConfigCanLoad) {
   EXPECT_FALSE(cfg.tracker.initial_pose.has_value());
   EXPECT_DOUBLE_EQ(cfg.tracker.fps, 30);
   fs::remove_all(dir);
+}
+
+// sequence.toml is tracked from the sequence's folder, wherever the input
+// config was: a gripper's model_file given relative to the input config, and
+// plugin folders given on the command line, are written as absolute paths.
+TEST(Synth, SequenceConfigCarriesFilesAndPluginFoldersAbsolute) {
+  const fs::path base = fs::temp_directory_path() / "gtrack_synth_paths";
+  fs::remove_all(base);
+  fs::create_directories(base / "cfg");
+  fs::create_directories(base / "extra_plugins");
+  // configs/microscope_custom_gripper.toml with its [gripper] moved to a model_file.
+  std::ifstream in(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_custom_gripper.toml");
+  std::string line, config, model;
+  bool in_gripper = false;
+  while (std::getline(in, line)) {
+    if (line.starts_with("[")) in_gripper = line.starts_with("[gripper") || line.starts_with("[[gripper");
+    if (!in_gripper) {
+      config += line + "\n";
+    } else if (line.starts_with("[gripper]")) {
+      config += "[gripper]\nplugin = \"data_defined\"\nmodel_file = \"models/star.toml\"\n";
+    } else if (!line.starts_with("plugin")) {
+      model += (line.starts_with("[[gripper.finger]]") ? std::string("[[finger]]") : line) + "\n";
+    }
+  }
+  fs::create_directories(base / "cfg" / "models");
+  std::ofstream(base / "cfg" / "models" / "star.toml") << model;
+  std::ofstream(base / "cfg" / "config.toml") << config;
+
+  gtrack::SetupOptions so;
+  so.plugin_paths = {base / "extra_plugins"};
+  const gtrack::Setup setup = gtrack::load_setup(base / "cfg" / "config.toml", so);
+  gtrack::SynthOptions o;
+  o.frames = 2;
+  const fs::path dir = base / "seq";
+  gtrack::write_synthetic_sequence(setup, o, dir);
+  std::ifstream t(dir / "sequence.toml");
+  const std::string text((std::istreambuf_iterator<char>(t)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("model_file = '" + (base / "cfg" / "models" / "star.toml").string() + "'"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find((base / "extra_plugins").string()), std::string::npos) << text;
+  const gtrack::Setup seq = gtrack::load_setup(dir / "sequence.toml", {});
+  EXPECT_EQ(seq.model().fingers(), 4);
+  fs::remove_all(base);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   Setup s;
   s.root = root;
   s.config_file = root.source();
+  s.plugin_paths = options.plugin_paths;
   auto loader = std::make_shared<PluginLoader>(options.plugin_paths);
   const fs::path base = s.config_file.has_parent_path() ? s.config_file.parent_path() : fs::path(".");
   for (const auto& p : root.strings_or("plugin_path", {})) {

@@ -70,10 +70,11 @@ inline const char* to_string(PluginKind kind) {
 #define GTRACK_PLUGIN(Class, Interface, Name, Version, Summary)                                      \
   static_assert(std::is_base_of_v<Interface, Class>,                                                 \
                 "GTRACK_PLUGIN: " #Class " must derive from " #Interface);                           \
-  static_assert(std::is_constructible_v<Class, const ::gtrack::ConfigTable&>,                        \
-                "GTRACK_PLUGIN: " #Class " needs a constructor taking const gtrack::ConfigTable&");  \
   static_assert(!std::is_abstract_v<Class>,                                                          \
                 "GTRACK_PLUGIN: " #Class " does not implement every pure virtual of " #Interface);   \
+  /* an abstract class is never constructible: the line above says why */                          \
+  static_assert(std::is_abstract_v<Class> || std::is_constructible_v<Class, const ::gtrack::ConfigTable&>, \
+                "GTRACK_PLUGIN: " #Class " needs a constructor taking const gtrack::ConfigTable&");  \
   namespace gtrack_plugin_detail {                                                                   \
   const ::gtrack::PluginInfo plugin_info{GTRACK_PLUGIN_ABI_VERSION,                                  \
                                          sizeof(::gtrack::PluginInfo),                               \

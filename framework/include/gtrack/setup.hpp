@@ -29,6 +29,7 @@ struct Setup {
   std::shared_ptr<Sensor> sensor;
   std::shared_ptr<Gripper> gripper;
   std::shared_ptr<Stimulus> stimulus;  // may be null when not asked for
+  std::vector<std::filesystem::path> plugin_paths;  // SetupOptions::plugin_paths (the command line's)
 
   const ArticulatedModel& model() const { return gripper->model(); }
 };

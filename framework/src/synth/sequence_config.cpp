@@ -1,13 +1,15 @@
 // sequence.toml: the input config, made to track a synthetic sequence as is.
 //
 // The input is re-emitted table by table through TOML++ (comments are not
-// kept; the plugin tables' values are). Relative plugin folders are made
-// absolute, because the sequence folder is usually elsewhere. The frame rate
+// kept; the plugin tables' values are). Relative plugin folders and files
+// (keys ending in "_file") are made absolute, because the sequence folder is
+// usually elsewhere; folders given on the command line are written first. The frame rate
 // is the sequence's, so that stimulus rates mean the same as when planned.
 // A configured initial pose is dropped: it described some other scene, and
 // the sequence must be tracked from the coarse search like a new recording.
 #include <filesystem>
 #include <fstream>
+#include <vector>
 #include <toml++/toml.h>
 
 #include "gtrack/error.hpp"
@@ -15,8 +17,25 @@
 
 namespace gtrack {
 
+namespace {
+
+// Relative paths in keys ending in "_file" (a gripper's model_file), at any
+// depth of a plugin table, made absolute against the input config's folder.
+void absolute_files(toml::table& table, const std::filesystem::path& base) {
+  for (auto&& [key, node] : table) {
+    if (auto* sub = node.as_table()) {
+      absolute_files(*sub, base);
+    } else if (auto* s = node.as_string(); s && key.str().ends_with("_file")) {
+      const std::filesystem::path p(s->get());
+      if (!p.empty() && p.is_relative()) *s = (base / p).lexically_normal().string();
+    }
+  }
+}
+
+}  // namespace
+
 void write_sequence_config(const std::filesystem::path& input_config, const SynthPlan& plan,
-                           const std::filesystem::path& out_file) {
+                           const std::filesystem::path& out_file, const std::vector<std::filesystem::path>& plugin_paths) {
   namespace fs = std::filesystem;
   toml::table root;
   try {
@@ -25,15 +44,19 @@ void write_sequence_config(const std::filesystem::path& input_config, const Synt
     throw ConfigError(input_config.string() + ": " + std::string(e.description()));
   }
   const fs::path base = fs::absolute(input_config).parent_path();
+  toml::array abs;
+  for (const fs::path& dir : plugin_paths) abs.push_back(fs::absolute(dir).lexically_normal().string());
   if (auto* paths = root["plugin_path"].as_array()) {
-    toml::array abs;
     for (auto& p : *paths) {
       if (auto s = p.value<std::string>()) {
         const fs::path dir(*s);
         abs.push_back((dir.is_absolute() ? dir : (base / dir).lexically_normal()).string());
       }
     }
-    root.insert_or_assign("plugin_path", std::move(abs));
+  }
+  if (!abs.empty()) root.insert_or_assign("plugin_path", std::move(abs));
+  for (const char* t : {"sensor", "gripper", "stimulus"}) {
+    if (auto* table = root[t].as_table()) absolute_files(*table, base);
   }
   if (!root["tracker"].as_table()) root.insert_or_assign("tracker", toml::table{});
   toml::table& tracker = *root["tracker"].as_table();
