@@ -32,13 +32,22 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::Setup setup = gtrack::load_setup(config, so);
   const std::filesystem::path out = vm["out"].as<std::string>();
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
+  std::string unit;
+  if (setup.stimulus) unit.append(" ").append(setup.stimulus->reading_unit());
   std::cout << "synthetic sequence: " << s.frames << " frames (preset " << o.preset << ", seed " << o.seed << ") in "
             << s.seconds << " s -> " << out.string() << "\n"
             << "  occluded frames: " << s.occluded_frames << " (" << 100.0 * s.occluded_frames / s.frames
             << "%), mean " << 100 * s.mean_occlusion << "% of the shape, max " << 100 * s.max_occlusion << "%\n"
             << "  partly out of view: " << s.partly_out_frames << ", out of view (<10% inside): "
             << s.out_of_view_frames << "\n"
-            << "  track it: gtrack track --config " << s.sequence_config.string() << " --input "
+            << "  stimulus: " << s.stimulus_low << " to " << s.stimulus_high << unit << ", joints: " << s.joint_min_deg
+            << " to " << s.joint_max_deg << " deg\n";
+  // From 2.5 s on, a sequence holds a whole heating and cooling cycle.
+  if (s.duration_s >= 2.5 && s.joint_max_deg - s.joint_min_deg < 1) {
+    std::cout << "  note: the joints do not fold: the stimulus never crosses the plugin's fold band; set "
+                 "stimulus_low and stimulus_high in the config's [synth] table\n";
+  }
+  std::cout << "  track it: gtrack track --config " << s.sequence_config.string() << " --input "
             << (out / "frames").string() << " --stimulus " << (out / "stimulus.csv").string() << " --out "
             << (out / "track").string() << "\n";
   return 0;

@@ -221,4 +221,55 @@ TEST(Synth, SequenceConfigCarriesFilesAndPluginFoldersAbsolute) {
   fs::remove_all(base);
 }
 
+// The config's [synth] table sets the stimulus profile in the plugin's own
+// units; misspelt keys and an empty range are one-line errors that name the
+// file, the line and the key, raised before the output folder is touched.
+gtrack::Setup microscope_with(const std::string& synth_table) {
+  const fs::path file = fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml";
+  std::ifstream in(file);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return gtrack::load_setup(gtrack::ConfigTable::parse(text + "\n[synth]\n" + synth_table, "with_synth.toml"), {});
+}
+
+TEST(Synth, SynthTableSetsTheStimulusProfile) {
+  gtrack::SynthOptions o;
+  o.frames = 300;
+  const auto preset = gtrack::plan_sequence(microscope(), o);
+  const auto own = gtrack::plan_sequence(microscope_with("stimulus_low = 40\nstimulus_high = 90\nstimulus_noise = 0\n"), o);
+  EXPECT_DOUBLE_EQ(own.preset.stimulus_low, 40);
+  EXPECT_DOUBLE_EQ(own.preset.stimulus_high, 90);
+  double lo = 1e9, hi = -1e9, preset_hi = -1e9;
+  for (const auto& f : own.frames) lo = std::min(lo, f.stimulus), hi = std::max(hi, f.stimulus);
+  for (const auto& f : preset.frames) preset_hi = std::max(preset_hi, f.stimulus);
+  EXPECT_DOUBLE_EQ(lo, 40);  // the profile holds at both ends, and there is no reading noise
+  EXPECT_DOUBLE_EQ(hi, 90);
+  EXPECT_LT(preset_hi, 31);
+  // Only the stimulus changed: the motion of a seed is the same.
+  EXPECT_EQ(own.frames[100].truth.head<6>(), preset.frames[100].truth.head<6>());
+}
+
+TEST(Synth, SynthTableErrorsNameTheKeyAndLeaveTheFolderAlone) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_synth_table_error";
+  fs::remove_all(dir);
+  gtrack::SynthOptions o;
+  o.frames = 2;
+  auto message = [&](const std::string& table) {
+    try {
+      gtrack::write_synthetic_sequence(microscope_with(table), o, dir);
+    } catch (const gtrack::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string typo = message("stimulus_low = 0\nstimulus_hgh = 80\n");
+  EXPECT_NE(typo.find("with_synth.toml:"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("synth.stimulus_hgh"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("did you mean 'stimulus_high'"), std::string::npos) << typo;
+  const std::string empty = message("stimulus_low = 50\nstimulus_high = 40\n");
+  EXPECT_NE(empty.find("synth.stimulus_high"), std::string::npos) << empty;
+  EXPECT_NE(empty.find("greater than stimulus_low"), std::string::npos) << empty;
+  EXPECT_NE(message("stimulus_period_s = 0\n").find("synth.stimulus_period_s"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir));
+}
+
 }  // namespace

@@ -5,7 +5,9 @@
 // irradiance is above `fold_above_mW_cm2` and relax below
 // `unfold_below_mW_cm2`. The log is the usual stimulus CSV with the
 // irradiance as its value column. S(H) follows the temperature plugin's
-// rule: joints outside the band the light allows are infeasible. The swarm
+// rule: joints outside the band the light allows are infeasible. The hinges
+// take time to follow the light, so for `settle_s` seconds after the light
+// leaves the band the whole range stays feasible. The swarm
 // bias is simpler: while the light is in the band and rising (by more than
 // `trend_threshold_mW_cm2_per_s`), most particles start more folded.
 #include <algorithm>
@@ -24,6 +26,7 @@ class LightIntensity final : public gtrack::Stimulus {
     folded_ = t.number_or("folded_deg", 50.0);
     tolerance_ = t.number_or("tolerance_deg", 8.0, Range::non_negative());
     threshold_ = t.number_or("trend_threshold_mW_cm2_per_s", 1.0, Range::non_negative());
+    settle_s_ = t.number_or("settle_s", 1.5, Range::non_negative());
     if (!(unfold_below_ < fold_above_)) t.fail("fold_above_mW_cm2", "must be greater than unfold_below_mW_cm2");
     if (folded_ == unfolded_) t.fail("folded_deg", "must differ from unfolded_deg");
   }
@@ -31,6 +34,10 @@ class LightIntensity final : public gtrack::Stimulus {
   void update(double value, double time_s) override {
     if (!std::isfinite(value)) return;
     rate_ = have_ && time_s > t_ ? (value - value_) / (time_s - t_) : 0.0;
+    const int region = value >= fold_above_ ? 1 : value <= unfold_below_ ? -1 : 0;
+    // A log that starts outside the band starts settled.
+    if (region != region_) region_since_ = have_ ? time_s : time_s - settle_s_;
+    region_ = region;
     value_ = value;
     t_ = time_s;
     have_ = true;
@@ -43,7 +50,7 @@ class LightIntensity final : public gtrack::Stimulus {
     s.trend = rate_ > threshold_ ? gtrack::StimulusTrend::Folding
               : rate_ < -threshold_ ? gtrack::StimulusTrend::Unfolding
                                     : gtrack::StimulusTrend::Steady;
-    s.in_transition = value_ > unfold_below_ && value_ < fold_above_;
+    s.in_transition = region_ == 0 || t_ - region_since_ < settle_s_;
     const double ref = value_ >= fold_above_ ? folded_ : unfolded_;
     if (s.in_transition) {
       s.feasible_min_deg = std::min(unfolded_, folded_) - tolerance_;
@@ -86,8 +93,9 @@ class LightIntensity final : public gtrack::Stimulus {
   std::string reading_unit() const override { return "mW/cm2"; }
 
  private:
-  double unfold_below_, fold_above_, unfolded_, folded_, tolerance_, threshold_;
-  double value_ = 0, rate_ = 0, t_ = 0;
+  double unfold_below_, fold_above_, unfolded_, folded_, tolerance_, threshold_, settle_s_;
+  double value_ = 0, rate_ = 0, t_ = 0, region_since_ = 0;
+  int region_ = 0;  // -1 below the band, 0 in it, 1 above
   bool have_ = false;
 };
 

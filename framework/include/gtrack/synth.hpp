@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -47,7 +48,9 @@ struct SynthPreset {
   double exits_per_minute = 12;         // excursions out of the field of view
   double exit_depth = 1.15;             // how far out: 1 = the model's edge touches the border
 
-  // Stimulus (temperature) profile and the joints' response.
+  // Stimulus (temperature) profile and the joints' response. The config's
+  // [synth] table may set the profile (stimulus_low, stimulus_high,
+  // stimulus_period_s, stimulus_noise) in its stimulus plugin's units.
   double stimulus_low = 22, stimulus_high = 30;
   double stimulus_period_s = 7;
   double stimulus_noise = 0.03;         // reading noise, stimulus units
@@ -130,7 +133,11 @@ struct SynthSummary {
   int out_of_view_frames = 0;   // less than 10% in view
   double mean_occlusion = 0;    // over occluded frames
   double max_occlusion = 0;
-  double seconds = 0;
+  double seconds = 0;            // to plan, draw and write
+  double duration_s = 0;         // of the sequence, at the preset's frame rate
+  double stimulus_low = 0, stimulus_high = 0;  // the profile's range, as planned
+  double joint_min_deg = std::numeric_limits<double>::infinity();   // over fingers and frames
+  double joint_max_deg = -std::numeric_limits<double>::infinity();
   std::filesystem::path sequence_config;
 };
 

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <sstream>
 
 #include "gtrack/error.hpp"
 #include "gtrack/synth.hpp"
@@ -100,6 +101,25 @@ std::vector<OccluderPlan> plan_occlusions(const SynthPreset& p, int frames, doub
   return plan;
 }
 
+// The config's optional [synth] table: the stimulus profile in the units of
+// the setup's stimulus plugin (a light, a field or a pH in place of the
+// presets' temperature), so that any plugin's fold and unfold band can be
+// crossed. Every key is optional; the preset gives the rest.
+void apply_synth_table(SynthPreset& p, const ConfigTable& t) {
+  std::ostringstream r;
+  r << p.stimulus_low << " and " << p.stimulus_high;
+  const std::string preset_range = r.str();
+  p.stimulus_low = t.number_or("stimulus_low", p.stimulus_low);
+  p.stimulus_high = t.number_or("stimulus_high", p.stimulus_high);
+  p.stimulus_period_s = t.number_or("stimulus_period_s", p.stimulus_period_s, Range::positive());
+  p.stimulus_noise = t.number_or("stimulus_noise", p.stimulus_noise, Range::non_negative());
+  t.check_all_used();  // a misspelt key first: it explains the comparison below
+  if (!(p.stimulus_low < p.stimulus_high)) {
+    t.fail(t.has("stimulus_high") ? "stimulus_high" : "stimulus_low",
+           "stimulus_high must be greater than stimulus_low (the preset's are " + preset_range + ")");
+  }
+}
+
 }  // namespace
 
 SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
@@ -110,6 +130,7 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   SynthPlan plan;
   plan.preset = synth_preset(options.preset);
   plan.options = options;
+  apply_synth_table(plan.preset, setup.root.table("synth"));
   const SynthPreset& p = plan.preset;
   const ArticulatedModel& model = setup.model();
   const Sensor& sensor = *setup.sensor;

@@ -20,6 +20,8 @@ namespace fs = std::filesystem;
 
 SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& options, const fs::path& out) {
   const auto start = std::chrono::steady_clock::now();
+  // Planned before the folder is touched: a config error leaves it as it was.
+  const SynthPlan plan = plan_sequence(setup, options);
   std::error_code ec;
   fs::create_directories(out / "frames", ec);
   if (ec) throw InputError(out.string() + ": cannot create the folder (" + ec.message() + ")");
@@ -29,7 +31,6 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
     logger().info("{}: removed the {} frames of an earlier sequence", (out / "frames").string(), stale);
   }
 
-  const SynthPlan plan = plan_sequence(setup, options);
   const int n = static_cast<int>(plan.frames.size());
   std::vector<SynthVisibility> vis(n);
   std::atomic<int> next{0};
@@ -70,6 +71,16 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   }
   SynthSummary s;
   s.frames = n;
+  s.duration_s = n / plan.preset.frame_rate_hz;
+  s.stimulus_low = plan.preset.stimulus_low;
+  s.stimulus_high = plan.preset.stimulus_high;
+  const int F = setup.model().fingers();
+  for (const auto& f : plan.frames) {
+    for (int k = 0; k < F; ++k) {
+      s.joint_min_deg = std::min(s.joint_min_deg, f.truth[kPoseDims + k]);
+      s.joint_max_deg = std::max(s.joint_max_deg, f.truth[kPoseDims + k]);
+    }
+  }
   {
     std::ofstream csv(out / "ground_truth.csv");
     csv << pose_table_header(setup.model().fingers(), {"visible", "in_view", "occluded"}) << "\n";
