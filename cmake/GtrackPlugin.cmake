@@ -24,7 +24,8 @@ function(gtrack_add_plugin name)
     VISIBILITY_INLINES_HIDDEN ON
     CXX_STANDARD 20
     CXX_STANDARD_REQUIRED ON)
-  target_compile_definitions(${name} PRIVATE GTRACK_PLUGIN_KIND_${ARG_KIND}=1)
+  # GTRACK_PLUGIN checks its name and interface against these at compile time.
+  target_compile_definitions(${name} PRIVATE GTRACK_PLUGIN_KIND_${ARG_KIND}=1 GTRACK_PLUGIN_TARGET="${name}")
   # A plugin's terms run hundreds of times a frame: optimised even when the
   # project sets no build type.
   if(NOT CMAKE_BUILD_TYPE AND NOT CMAKE_CONFIGURATION_TYPES)

@@ -96,6 +96,28 @@ TEST(PluginLoader, CannotLoadIsReported) {
   EXPECT_NO_THROW(loader.discover());
 }
 
+// A library whose file name is not libgtrack_<its declared name>.so can never
+// be loaded by name: discovery skips it instead of listing a name that fails.
+TEST(PluginLoader, DiscoverySkipsALibraryNamedOtherwise) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_loader_renamed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(kFixtures / "libgtrack_fixture_good_sensor.so", dir / "libgtrack_renamed.so");
+  gtrack::PluginLoader loader({dir});
+  for (const auto& r : loader.discover()) {
+    EXPECT_NE(r.name, "fixture_good_sensor");
+    EXPECT_NE(r.name, "renamed");
+  }
+  const std::string e = plugin_error([&] { loader.make_sensor(table("renamed")); });
+  EXPECT_NE(e.find("declares the plugin name 'fixture_good_sensor', expected 'renamed'"), std::string::npos) << e;
+  // The same library under its own name is listed.
+  fs::copy_file(kFixtures / "libgtrack_fixture_good_sensor.so", dir / "libgtrack_fixture_good_sensor.so");
+  bool listed = false;
+  for (const auto& r : loader.discover()) listed = listed || r.name == "fixture_good_sensor";
+  EXPECT_TRUE(listed);
+  fs::remove_all(dir);
+}
+
 TEST(PluginLoader, UnknownKeyInThePluginTable) {
   gtrack::PluginLoader loader({kFixtures});
   auto root = gtrack::ConfigTable::parse("[sensor]\nplugin = \"fixture_good_sensor\"\nsise = 3\n", "k.toml");

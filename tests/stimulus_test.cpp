@@ -1,12 +1,21 @@
-// temperature_hysteresis against the paper's rules (Sections 2.2, 3, 5).
+// temperature_hysteresis against the paper's rules (Sections 2.2, 3, 5), and
+// the setup's check of a stimulus's reference joints against the gripper's.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
 #include <numbers>
+#include <sstream>
+#include <spdlog/sinks/ostream_sink.h>
 #include <string>
 #include <vector>
 
+#include "gtrack/log.hpp"
+#include "gtrack/setup.hpp"
 #include "support/plugins.hpp"
 
 using gtrack::testing::make_stimulus;
@@ -158,6 +167,39 @@ TEST(TemperatureHysteresis, BadTablesAreRejected) {
                gtrack::ConfigError);
   EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nfold_bias = 2"), gtrack::ConfigError);
   EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nresponse_s = -1"), gtrack::ConfigError);
+}
+
+}  // namespace
+
+// A stimulus table whose reference joints differ from the gripper's is
+// loaded, with a warning that names the file, the line and both values.
+namespace {
+
+std::string setup_warnings(const std::string& from, const std::string& to) {
+  std::ifstream in(std::filesystem::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(from);
+  if (at == std::string::npos) return "config line not found: " + from;
+  text.replace(at, from.size(), to);
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  gtrack::logger().sinks().push_back(sink);
+  try {
+    gtrack::load_setup(gtrack::ConfigTable::parse(text, "refs.toml"), {});
+  } catch (...) {
+    gtrack::logger().sinks().pop_back();
+    throw;
+  }
+  gtrack::logger().sinks().pop_back();
+  return log.str();
+}
+
+TEST(Setup, WarnsWhenTheStimulusReferenceJointsDifferFromTheGripper) {
+  EXPECT_EQ(setup_warnings("folded_deg = 60.0", "folded_deg = 60.0"), "");
+  const std::string w = setup_warnings("folded_deg = 60.0", "folded_deg = 55.0");
+  EXPECT_NE(w.find("refs.toml:"), std::string::npos) << w;
+  EXPECT_NE(w.find("stimulus.folded_deg"), std::string::npos) << w;
+  EXPECT_NE(w.find("55 differs from the gripper's folded_deg = 60"), std::string::npos) << w;
 }
 
 }  // namespace

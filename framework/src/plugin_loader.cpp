@@ -177,6 +177,13 @@ std::vector<PluginRecord> PluginLoader::discover() const {
     for (const auto& f : files) {
       try {
         PluginRecord r = inspect(f);
+        // Found by its file, a plugin named otherwise could never be loaded.
+        if (f.filename().string() != library_file_name(r.name)) {
+          logger().warn("skipping {}: it declares the {} plugin '{}', which gtrack looks for as {}; rename the file "
+                        "or the name in GTRACK_PLUGIN",
+                        f.string(), to_string(r.kind), r.name, library_file_name(r.name));
+          continue;
+        }
         std::string key = std::string(to_string(r.kind)) + "/" + r.name;
         if (seen[key]) continue;
         seen[key] = true;

@@ -1,11 +1,39 @@
 // Loading the three plugins a config names.
 #include "gtrack/setup.hpp"
 
+#include <cmath>
+#include <utility>
+
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 
 namespace gtrack {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The stimulus's reference joint values, where its table gives them, describe
+// the same open and folded shapes as the gripper's: a difference makes S(H)
+// pull the joints away from the shapes the coarse search and the fallback use.
+void warn_on_reference_mismatch(const ConfigTable& stimulus, const GripperGeometry& g) {
+  const std::pair<const char*, double> refs[] = {{"unfolded_deg", g.unfolded_deg}, {"folded_deg", g.folded_deg}};
+  for (const auto& [key, gripper_value] : refs) {
+    if (!stimulus.has(key)) continue;
+    double v = 0;
+    try {
+      v = stimulus.number(key);
+    } catch (const ConfigError&) {
+      continue;  // not a number: the plugin's own reading of it decides
+    }
+    if (std::abs(v - gripper_value) > 1e-9) {
+      logger().warn("{}: {} differs from the gripper's {} = {}; both describe the same shape and should agree",
+                    stimulus.where(key), v, key, gripper_value);
+    }
+  }
+}
+
+}  // namespace
 
 Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   Setup s;
@@ -31,6 +59,7 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
       root.fail("stimulus", "missing table [stimulus]; it must name a stimulus plugin" + root.misspelling_hint("stimulus"));
     }
     s.stimulus = loader->make_stimulus(root.table("stimulus"));
+    warn_on_reference_mismatch(root.table("stimulus"), s.model().geometry());
   } else {
     root.mark_used("stimulus");
   }

@@ -4,7 +4,9 @@
 //     GTRACK_PLUGIN(MySensor, gtrack::Sensor, "my_sensor", "1.0.0", "what it is")
 //
 // The macro checks at compile time that the class implements the interface
-// and is constructible from a ConfigTable, and exports through Boost.DLL
+// and is constructible from a ConfigTable and, when built with
+// gtrack_add_plugin, that the name and the interface are the target's NAME
+// and KIND (gtrack finds a plugin by its file, libgtrack_NAME.so), and exports through Boost.DLL
 // aliases a PluginInfo record and a factory. The loader reads PluginInfo and
 // compares the ABI version, the record's size and alignment, and the kind,
 // before it calls anything in the library.
@@ -12,6 +14,7 @@
 
 #include <boost/dll/alias.hpp>
 #include <cstdint>
+#include <string_view>
 #include <type_traits>
 
 #include "gtrack/config.hpp"
@@ -56,6 +59,24 @@ struct PluginTraits<Stimulus> {
 template <class Interface>
 using PluginFactory = Interface*(const ConfigTable&);
 
+namespace plugin_detail {
+// What gtrack_add_plugin says the library is (nothing when built otherwise).
+#ifdef GTRACK_PLUGIN_TARGET
+static constexpr std::string_view kTargetName = GTRACK_PLUGIN_TARGET;
+#else
+static constexpr std::string_view kTargetName = {};
+#endif
+#if defined(GTRACK_PLUGIN_KIND_sensor)
+static constexpr PluginKind kTargetKind = PluginKind::Sensor;
+#elif defined(GTRACK_PLUGIN_KIND_gripper)
+static constexpr PluginKind kTargetKind = PluginKind::Gripper;
+#elif defined(GTRACK_PLUGIN_KIND_stimulus)
+static constexpr PluginKind kTargetKind = PluginKind::Stimulus;
+#else
+static constexpr PluginKind kTargetKind{0};
+#endif
+}  // namespace plugin_detail
+
 inline const char* to_string(PluginKind kind) {
   switch (kind) {
     case PluginKind::Sensor: return "sensor";
@@ -75,6 +96,13 @@ inline const char* to_string(PluginKind kind) {
   /* an abstract class is never constructible: the line above says why */                          \
   static_assert(std::is_abstract_v<Class> || std::is_constructible_v<Class, const ::gtrack::ConfigTable&>, \
                 "GTRACK_PLUGIN: " #Class " needs a constructor taking const gtrack::ConfigTable&");  \
+  static_assert(::gtrack::plugin_detail::kTargetName.empty() ||                                      \
+                    ::gtrack::plugin_detail::kTargetName == std::string_view(Name),                  \
+                "GTRACK_PLUGIN: the name must be the NAME given to gtrack_add_plugin: gtrack finds " \
+                "the plugin by its file, libgtrack_NAME.so");                                        \
+  static_assert(::gtrack::plugin_detail::kTargetKind == ::gtrack::PluginKind{0} ||                   \
+                    ::gtrack::plugin_detail::kTargetKind == ::gtrack::PluginTraits<Interface>::kind, \
+                "GTRACK_PLUGIN: " #Interface " is not the KIND given to gtrack_add_plugin");        \
   namespace gtrack_plugin_detail {                                                                   \
   const ::gtrack::PluginInfo plugin_info{GTRACK_PLUGIN_ABI_VERSION,                                  \
                                          sizeof(::gtrack::PluginInfo),                               \
