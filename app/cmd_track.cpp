@@ -56,6 +56,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.save_masks = vm.count("save-masks") > 0;
   if (vm.count("no-overlay")) opt.overlay = false;
   opt.resume = vm.count("resume") > 0;
+  opt.durable = vm.count("durable") > 0;
   opt.follow_stimulus = vm.count("follow-stimulus") > 0;
   if (vm.count("restart-from")) opt.restart_from = vm["restart-from"].as<std::string>();
   if (vm.count("score-truth")) opt.score_truth = vm["score-truth"].as<std::string>();
@@ -153,6 +154,8 @@ GTRACK_COMMAND(
           "the forward or the backward estimate, chosen over the sequence by their costs and continuity, "
           "orientations smoothed over neighbouring frames ([tracker] two_pass_smoothing)")(
           "resume", "continue the run whose files are in OUT after its last finished frame")(
+          "durable", "put each frame's estimates and the tracker state on the disk (fsync) before the next frame: "
+                     "a power loss then loses no finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
           "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(
           "follow-input", po::value<double>(),

@@ -23,6 +23,9 @@ class GTRACK_API ResultWriter {
   // append: continue the files already there (after resume_results).
   ResultWriter(const std::filesystem::path& out_dir, int fingers, bool append = false);
   void write(const Estimate& estimate);
+  // Puts the rows written so far on the disk (fsync), not only in the
+  // system's cache: they then survive a power loss.
+  void sync();
   void close();
 
  private:

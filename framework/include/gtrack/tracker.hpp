@@ -162,6 +162,12 @@ struct TrackOptions {
   // Continue the run whose files are in out_dir, after the last frame its
   // tracker_state.txt records (none there: start from the first frame).
   bool resume = false;
+  // Each frame's rows, then the tracker state, are on the disk (fsync)
+  // before the next frame, so that a power loss loses no finished frame and
+  // --resume continues after the last one. Without it a crash or a kill
+  // loses nothing either; a power loss can lose what the system had not yet
+  // written, and --resume then refuses with a one-line error.
+  bool durable = false;
   // The stimulus log is still being written (a live run): before each frame
   // its new rows are read, and the frame takes the last row's reading.
   bool follow_stimulus = false;

@@ -41,7 +41,9 @@ struct TrackerState {
 };
 
 // Replaces `file` (write, then rename): never a half-written state.
-GTRACK_API void write_tracker_state(const std::filesystem::path& file, const TrackerState& state);
+// durable: on the disk when it returns (fsync of the data and the folder).
+GTRACK_API void write_tracker_state(const std::filesystem::path& file, const TrackerState& state,
+                                    bool durable = false);
 // InputError "name:line: ..." when the text is not a tracker state.
 GTRACK_API TrackerState parse_tracker_state(std::string_view text, const std::string& name);
 GTRACK_API TrackerState read_tracker_state(const std::filesystem::path& file);

@@ -1,7 +1,12 @@
 // Replacing a file whole: its new text goes to FILE.tmp, which is then
 // renamed over FILE, so a reader (or a resumed run) never sees it half
-// written.
+// written. Durable: FILE.tmp's data reach the disk before the rename, and the
+// rename before the call returns, so a power loss leaves the old or the new
+// text, not an empty file.
 #pragma once
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -12,7 +17,16 @@
 
 namespace gtrack::detail {
 
-inline void replace_file(const std::filesystem::path& file, const std::string& text) {
+// Flushes a file's (or a folder's) data from the page cache to the disk.
+inline void sync_to_disk(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(path.string() + ": cannot open to sync to the disk");
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  if (rc != 0) throw InputError(path.string() + ": syncing to the disk failed");
+}
+
+inline void replace_file(const std::filesystem::path& file, const std::string& text, bool durable = false) {
   const std::filesystem::path tmp = file.string() + ".tmp";
   {
     std::ofstream out(tmp, std::ios::trunc | std::ios::binary);
@@ -20,9 +34,11 @@ inline void replace_file(const std::filesystem::path& file, const std::string& t
     out.flush();
     if (!out) throw InputError(tmp.string() + ": write failed");
   }
+  if (durable) sync_to_disk(tmp);
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);
   if (ec) throw InputError(file.string() + ": cannot replace (" + ec.message() + ")");
+  if (durable) sync_to_disk(file.has_parent_path() ? file.parent_path() : std::filesystem::path("."));
 }
 
 }  // namespace gtrack::detail

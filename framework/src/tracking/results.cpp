@@ -90,6 +90,11 @@ void ResultWriter::write(const Estimate& e) {
   if (!csv_ || !jsonl_) throw InputError(dir_.string() + ": writing the estimates failed (disk full?)");
 }
 
+void ResultWriter::sync() {
+  detail::sync_to_disk(dir_ / "estimates.csv");
+  detail::sync_to_disk(dir_ / "estimates.jsonl");
+}
+
 std::string estimate_json(const Estimate& e) {
   const Eigen::VectorXd& h = e.hypothesis;
   static const char* pose[] = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};

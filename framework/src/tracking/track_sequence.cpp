@@ -298,7 +298,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     io_ms += seconds_since(t_write) * 1e3;
     e.times.io_ms = io_ms;
     results.write(e);
-    write_tracker_state(state_file, tracker.state());
+    if (options.durable) results.sync();  // the rows before the state that says they are done
+    write_tracker_state(state_file, tracker.state(), options.durable);
     if (options.on_frame) options.on_frame(e);
 
     ++summary.frames;

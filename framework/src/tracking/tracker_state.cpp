@@ -36,7 +36,7 @@ void write_vector(std::ostream& out, const char* name, const std::optional<Eigen
 
 }  // namespace
 
-void write_tracker_state(const fs::path& file, const TrackerState& s) {
+void write_tracker_state(const fs::path& file, const TrackerState& s, bool durable) {
   std::ostringstream out;
   out << "gtrack-tracker-state 1\n"
       << "frame " << s.frame << "\n"
@@ -47,7 +47,7 @@ void write_tracker_state(const fs::path& file, const TrackerState& s) {
   write_vector(out, "before_last", s.before_last);
   out << "last_found " << (s.last_found ? 1 : 0) << "\n";
   write_vector(out, "found_step", s.found_step);
-  detail::replace_file(file, out.str());
+  detail::replace_file(file, out.str(), durable);
 }
 
 TrackerState parse_tracker_state(std::string_view text, const std::string& name) {
