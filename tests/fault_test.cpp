@@ -436,6 +436,15 @@ std::vector<std::string> rows_without_time(const fs::path& csv) {
   return out;
 }
 
+// Tracks the run `o` describes into `out` (o.out_dir is set to it) and
+// returns its rows without the time column, the reference a variant of the
+// run is compared with.
+std::vector<std::string> tracked_rows(const TrackRun& r, gtrack::TrackOptions& o, const fs::path& out) {
+  o.out_dir = out;
+  gtrack::track_sequence(r.setup, r.config, o);
+  return rows_without_time(out / "estimates.csv");
+}
+
 // A run interrupted (Ctrl-C) after 3 of 8 frames and resumed gives the same
 // rows as a run that was never interrupted: the tracker's state, the
 // stimulus plugin's (replayed from the log) and the per-frame random draws
@@ -514,9 +523,7 @@ TEST(Fault, ResumeDropsRowsPastTheSavedState) {
   const fs::path dir = fresh_dir("resume_cut");
   const TrackRun r = make_run();
   gtrack::TrackOptions o = folder_run(dir, kFrames);
-  o.out_dir = dir / "whole";
-  gtrack::track_sequence(r.setup, r.config, o);
-  const auto reference = rows_without_time(o.out_dir / "estimates.csv");
+  const auto reference = tracked_rows(r, o, dir / "whole");
 
   o.out_dir = dir / "out";
   o.range.last = 4;
@@ -543,12 +550,11 @@ TEST(Fault, DurableRunWritesTheSameRowsAndState) {
   const fs::path dir = fresh_dir("durable");
   const TrackRun r = make_run();
   gtrack::TrackOptions o = folder_run(dir, kFrames);
-  o.out_dir = dir / "plain";
-  gtrack::track_sequence(r.setup, r.config, o);
-  o.out_dir = dir / "durable";
+  const auto plain = tracked_rows(r, o, dir / "plain");
   o.durable = true;
-  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, kFrames);
-  EXPECT_EQ(rows_without_time(dir / "durable" / "estimates.csv"), rows_without_time(dir / "plain" / "estimates.csv"));
+  const auto durable = tracked_rows(r, o, dir / "durable");
+  EXPECT_EQ(durable.size(), static_cast<size_t>(kFrames + 1));
+  EXPECT_EQ(durable, plain);
   EXPECT_EQ(read_lines(dir / "durable" / "estimates.jsonl").size(), static_cast<size_t>(kFrames));
   EXPECT_EQ(gtrack::read_tracker_state(dir / "durable" / "tracker_state.txt").frame, kFrames - 1);
   EXPECT_FALSE(fs::exists(dir / "durable" / "tracker_state.txt.tmp"));
