@@ -54,7 +54,7 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   const gtrack::TwoPassSummary both = gtrack::two_pass(setup, cfg, to, forward);
 
   std::cout << "3/3 evaluating ...\n";
-  const auto truth = gtrack::read_pose_table(seq / "ground_truth.csv");
+  const auto truth = gtrack::read_truth_table(seq / "ground_truth.csv");
   const auto estimates = gtrack::read_pose_table(to.out_dir / "estimates.csv");
   const auto ev = gtrack::evaluate(setup.model(), truth, estimates, {}, setup.sensor.get());
   const fs::path two_pass_csv = to.out_dir / "two_pass" / "estimates.csv";

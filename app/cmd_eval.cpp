@@ -177,7 +177,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     throw gtrack::cli::UsageError("--out-of-view-below must be a share in [0, 1)");
   }
   if (!(opt.off_track_endpoint_um > 0)) throw gtrack::cli::UsageError("--off-track-um must be positive");
-  const auto truth = gtrack::read_pose_table(truth_file);
+  const auto truth = gtrack::read_truth_table(truth_file);
   const auto estimates = gtrack::read_pose_table(estimates_file);
   for (const auto* t : {&truth, &estimates}) {
     if (t->rows.empty()) {

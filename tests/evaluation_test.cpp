@@ -221,6 +221,20 @@ TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:3"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("y_mm"), std::string::npos) << e.what();
   }
+  // An estimate may be lost (null); a ground truth may not, or every mean
+  // over it would come out NaN.
+  {
+    std::ofstream f(dir / "truth.csv");
+    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg\n0,1,2,3,4,5,6,7\n1,1,2,3,4,5,6,7\n2,1,2,3,4,5,6,nan\n";
+  }
+  EXPECT_EQ(gtrack::read_pose_table(dir / "truth.csv").rows.size(), 3u);
+  try {
+    gtrack::read_truth_table(dir / "truth.csv");
+    FAIL() << "a truth with NaN must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truth.csv:4: expected a finite number for 'q1_deg'"), std::string::npos)
+        << e.what();
+  }
   std::filesystem::remove_all(dir);
 }
 

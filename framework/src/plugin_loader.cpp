@@ -114,7 +114,9 @@ void warn_if_missing(const fs::path& dir, const char* from) {
   static std::set<std::string> warned;
   std::error_code ec;
   if (!fs::is_directory(dir, ec) && warned.insert(dir.string()).second) {
-    logger().warn("plugin folder {} ({}) does not exist", dir.string(), from);
+    const bool exists = fs::exists(dir, ec);
+    logger().warn("plugin folder {} ({}) {}", dir.string(), from,
+                  exists ? "is not a folder (plugins are found in folders, not named as files)" : "does not exist");
   }
 }
 

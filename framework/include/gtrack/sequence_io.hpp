@@ -22,6 +22,7 @@ struct PoseRow {
   Eigen::VectorXd h;   // x,y,z (mm), rx,ry,rz (deg), q1..qF (deg)
   std::string status;  // "" when the file has no status column
   std::map<std::string, double> extra;
+  int line = 0;        // in the file, for messages
 };
 
 struct PoseTable {
@@ -31,6 +32,10 @@ struct PoseTable {
 };
 
 GTRACK_API PoseTable read_pose_table(const std::filesystem::path& file);
+// A ground truth: a pose table whose every pose and joint is a finite number
+// (an estimate's lost frame may be null; a truth's may not). InputError
+// "file:line: ..." naming the first column that is not.
+GTRACK_API PoseTable read_truth_table(const std::filesystem::path& file);
 
 // Header of a pose table for `fingers` joints followed by `extra` columns.
 GTRACK_API std::string pose_table_header(int fingers, const std::vector<std::string>& extra);

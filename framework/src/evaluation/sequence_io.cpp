@@ -83,6 +83,7 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
       throw InputError(where + "expected a frame index (a whole number from 0), got '" + cells[idx[0]] + "'");
     }
     row.frame = static_cast<int>(v);
+    row.line = line_no;
     row.h.resize(kPoseDims + table.fingers);
     for (int d = 0; d < row.h.size(); ++d) {
       if (!parse_number(cells[idx[d + 1]], row.h[d])) {
@@ -109,6 +110,20 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
                        std::to_string(first->second) + ")");
     }
     table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+PoseTable read_truth_table(const std::filesystem::path& file) {
+  PoseTable table = read_pose_table(file);
+  static const char* pose[] = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
+  for (const PoseRow& row : table.rows) {
+    for (Eigen::Index d = 0; d < row.h.size(); ++d) {
+      if (std::isfinite(row.h[d])) continue;
+      const std::string name = d < kPoseDims ? pose[d] : joint_name(static_cast<int>(d) - kPoseDims + 1);
+      throw InputError(file.string() + ":" + std::to_string(row.line) + ": expected a finite number for '" + name +
+                       "' in a ground truth (frame " + std::to_string(row.frame) + ")");
+    }
   }
   return table;
 }

@@ -23,7 +23,7 @@ BenchmarkRun run_synthetic_benchmark(const Setup& setup, const EngineConfig& con
                                      int max_frames, const EvalOptions& eval_options,
                                      const std::function<void(int)>& on_frame) {
   const auto start = std::chrono::steady_clock::now();
-  const PoseTable truth = read_pose_table(dir / "ground_truth.csv");
+  const PoseTable truth = read_truth_table(dir / "ground_truth.csv");
   const StimulusLog log = StimulusLog::load(dir / "stimulus.csv");
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : 30.0;
   int n = static_cast<int>(truth.rows.size());
