@@ -22,7 +22,6 @@ struct PoseRow {
   Eigen::VectorXd h;   // x,y,z (mm), rx,ry,rz (deg), q1..qF (deg)
   std::string status;  // "" when the file has no status column
   std::map<std::string, double> extra;
-  int line = 0;        // in the file, for messages
 };
 
 struct PoseTable {

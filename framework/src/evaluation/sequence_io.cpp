@@ -39,7 +39,9 @@ bool parse_number(const std::string& s, double& v) {
 
 }  // namespace
 
-PoseTable read_pose_table(const std::filesystem::path& file) {
+// A truth must be finite in every pose and joint cell; an estimate's lost
+// frame may be null.
+static PoseTable read_table(const std::filesystem::path& file, bool finite) {
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot open");
   std::string line;
@@ -83,11 +85,14 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
       throw InputError(where + "expected a frame index (a whole number from 0), got '" + cells[idx[0]] + "'");
     }
     row.frame = static_cast<int>(v);
-    row.line = line_no;
     row.h.resize(kPoseDims + table.fingers);
     for (int d = 0; d < row.h.size(); ++d) {
       if (!parse_number(cells[idx[d + 1]], row.h[d])) {
         throw InputError(where + "expected a number for '" + names[d + 1] + "', got '" + cells[idx[d + 1]] + "'");
+      }
+      if (finite && !std::isfinite(row.h[d])) {
+        throw InputError(where + "expected a finite number for '" + names[d + 1] + "' in a ground truth (frame " +
+                         std::to_string(row.frame) + ")");
       }
     }
     if (status_col >= 0) {
@@ -114,19 +119,9 @@ PoseTable read_pose_table(const std::filesystem::path& file) {
   return table;
 }
 
-PoseTable read_truth_table(const std::filesystem::path& file) {
-  PoseTable table = read_pose_table(file);
-  static const char* pose[] = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
-  for (const PoseRow& row : table.rows) {
-    for (Eigen::Index d = 0; d < row.h.size(); ++d) {
-      if (std::isfinite(row.h[d])) continue;
-      const std::string name = d < kPoseDims ? pose[d] : joint_name(static_cast<int>(d) - kPoseDims + 1);
-      throw InputError(file.string() + ":" + std::to_string(row.line) + ": expected a finite number for '" + name +
-                       "' in a ground truth (frame " + std::to_string(row.frame) + ")");
-    }
-  }
-  return table;
-}
+PoseTable read_pose_table(const std::filesystem::path& file) { return read_table(file, false); }
+
+PoseTable read_truth_table(const std::filesystem::path& file) { return read_table(file, true); }
 
 std::string pose_table_header(int fingers, const std::vector<std::string>& extra) {
   std::string s = "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg";

@@ -76,10 +76,9 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   s.stimulus_high = plan.preset.stimulus_high;
   const int F = setup.model().fingers();
   for (const auto& f : plan.frames) {
-    for (int k = 0; k < F; ++k) {
-      s.joint_min_deg = std::min(s.joint_min_deg, f.truth[kPoseDims + k]);
-      s.joint_max_deg = std::max(s.joint_max_deg, f.truth[kPoseDims + k]);
-    }
+    if (F == 0) break;
+    s.joint_min_deg = std::min(s.joint_min_deg, f.truth.tail(F).minCoeff());
+    s.joint_max_deg = std::max(s.joint_max_deg, f.truth.tail(F).maxCoeff());
   }
   {
     std::ofstream csv(out / "ground_truth.csv");
