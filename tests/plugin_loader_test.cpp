@@ -73,6 +73,21 @@ TEST(PluginLoader, NotAGtrackPlugin) {
   EXPECT_NE(e.find("not a gtrack plugin"), std::string::npos) << e;
 }
 
+// Both exports are pointers held in variables; a null one is refused before
+// it is dereferenced, by load and by discovery alike.
+TEST(PluginLoader, RefusesANullInfoPointer) {
+  gtrack::PluginLoader loader({kFixtures});
+  std::string e = plugin_error([&] { loader.make_sensor(table("fixture_null_info")); });
+  EXPECT_NE(e.find("its gtrack_plugin_info is a null pointer"), std::string::npos) << e;
+  for (const auto& r : loader.discover()) EXPECT_NE(r.name, "fixture_null_info");
+}
+
+TEST(PluginLoader, NamesTheMissingFactory) {
+  gtrack::PluginLoader loader({kFixtures});
+  std::string e = plugin_error([&] { loader.make_sensor(table("fixture_no_create")); });
+  EXPECT_NE(e.find("it exports no gtrack_plugin_create"), std::string::npos) << e;
+}
+
 TEST(PluginLoader, WrongKind) {
   gtrack::PluginLoader loader({kFixtures});
   std::string e = plugin_error([&] { loader.make_gripper(table("fixture_wrong_kind", "gripper")); });

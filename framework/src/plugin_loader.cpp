@@ -63,9 +63,16 @@ std::shared_ptr<dll::shared_library> open_library(const fs::path& file) {
 // Reads and checks PluginInfo. Only reads data: no function of the library
 // runs before this has passed.
 PluginRecord check_info(const dll::shared_library& lib, const fs::path& file) {
-  if (!lib.has("gtrack_plugin_info") || !lib.has("gtrack_plugin_create")) {
-    throw PluginError(file.string() +
-                      ": not a gtrack plugin (it exports no gtrack_plugin_info; was it built with GTRACK_PLUGIN?)");
+  // Both symbols are aliases: variables that hold a pointer. A null one
+  // would be dereferenced by get_alias, so each is read as data first.
+  for (const char* symbol : {"gtrack_plugin_info", "gtrack_plugin_create"}) {
+    if (!lib.has(symbol)) {
+      throw PluginError(file.string() + ": not a gtrack plugin (it exports no " + symbol +
+                        "; was it built with GTRACK_PLUGIN?)");
+    }
+    if (lib.get<const void* const>(symbol) == nullptr) {
+      throw PluginError(file.string() + ": not a gtrack plugin (its " + symbol + " is a null pointer)");
+    }
   }
   const auto& head = lib.get_alias<const std::uint32_t>("gtrack_plugin_info");
   const std::uint32_t* words = &head;
