@@ -185,10 +185,12 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
                                ": a header and no rows; there is nothing to evaluate");
     }
   }
-  if (estimates.fingers != setup.model().fingers()) {
-    throw gtrack::InputError(estimates_file.string() + ": " + std::to_string(estimates.fingers) +
-                             " joint columns, the model in " + config.string() + " has " +
-                             std::to_string(setup.model().fingers()) + " fingers");
+  for (const auto* t : {&truth, &estimates}) {
+    if (t->fingers != setup.model().fingers()) {
+      throw gtrack::InputError((t == &truth ? truth_file : estimates_file).string() + ":1: " +
+                               std::to_string(t->fingers) + " joint columns, the model in " + config.string() +
+                               " has " + std::to_string(setup.model().fingers()) + " fingers");
+    }
   }
   // Estimates of frames the truth does not have are not evaluated: said once.
   std::set<int> truth_frames;

@@ -390,6 +390,22 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_EQ(nan_run.code, 1);
   EXPECT_NE(nan_run.output.find("nan_start.csv: frame 0: a configuration that is not finite"), std::string::npos)
       << nan_run.output;
+  // A truth with fewer joint columns than the model has fingers is refused
+  // as the estimates are, not read past its end.
+  std::vector<std::string> narrow;
+  for (const auto& l : rows) {
+    std::vector<std::string> cells;
+    std::stringstream ss(l);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    cells.erase(cells.begin() + 11, cells.begin() + 13);  // q5_deg, q6_deg
+    std::string joined;
+    for (const auto& c : cells) joined += (joined.empty() ? "" : ",") + c;
+    narrow.push_back(joined);
+  }
+  ASSERT_EQ(narrow[0].find("q5_deg"), std::string::npos) << narrow[0];
+  r = eval(table("four_fingers.csv", narrow), truth);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("four_fingers.csv:1: 4 joint columns, the model in"), std::string::npos) << r.output;
   r = eval(truth, table("header_only.csv", {rows[0]}));
   EXPECT_NE(r.output.find("header_only.csv: a header and no rows"), std::string::npos) << r.output;
   r = eval(dir / "no_such.csv", truth);

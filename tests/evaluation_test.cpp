@@ -195,6 +195,19 @@ TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
   }
 }
 
+// An estimate far enough away that its errors overflow is scored as far
+// away, never as the default of a perfect match.
+TEST(Evaluation, AnOverflowingErrorIsNotReportedAsZero) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  const Eigen::VectorXd truth = pose(0, 0, 100, 0, 0, 0, {10, 10, 10, 10, 10, 10});
+  Eigen::VectorXd est = truth;
+  est[0] = 1e200;
+  const auto e = gtrack::compare_to_truth(m, truth, est);
+  EXPECT_FALSE(e.position_um < 1e9) << e.position_um;
+  EXPECT_FALSE(e.endpoint_um < 1e9) << e.endpoint_um;
+}
+
 TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
   const auto dir = std::filesystem::temp_directory_path() / "gtrack_eval_test";
   std::filesystem::create_directories(dir);
@@ -233,6 +246,19 @@ TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
     FAIL() << "a truth with NaN must throw";
   } catch (const gtrack::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("truth.csv:4: expected a finite number for 'q1_deg'"), std::string::npos)
+        << e.what();
+  }
+  // A value no micro-gripper pose can have is refused by name and line.
+  {
+    std::ofstream f(dir / "far.csv");
+    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg\n0,1,2,3,4,5,6,7\n1,1e200,2,3,4,5,6,7\n";
+  }
+  try {
+    gtrack::read_pose_table(dir / "far.csv");
+    FAIL() << "a position of 1e200 mm must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("far.csv:3: 'x_mm' = 1e200 is not a plausible pose value"),
+              std::string::npos)
         << e.what();
   }
   std::filesystem::remove_all(dir);

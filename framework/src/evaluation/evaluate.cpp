@@ -4,6 +4,7 @@
 #include <map>
 #include <optional>
 
+#include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
 
 namespace gtrack {
@@ -62,6 +63,10 @@ void ErrorSet::finish() {
 
 Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const PoseTable& estimates,
                     const EvalOptions& options, const Sensor* sensor) {
+  if (truth.fingers != model.fingers()) {
+    throw InputError("the ground truth has " + std::to_string(truth.fingers) + " joint columns, the model has " +
+                     std::to_string(model.fingers()) + " fingers");
+  }
   Evaluation ev;
   ev.options = options;
   std::map<int, const PoseRow*> by_frame;

@@ -71,13 +71,15 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
   const auto truth_ends = model.link_endpoints(truth);
   const int order = std::max(1, model.geometry().symmetry_order);
   FrameErrors best;
-  double best_end = 1e300;
+  double best_end = 0;
   for (int k = 0; k < order; ++k) {
     Eigen::VectorXd e = model.symmetric_equivalent(estimate, k);
     // One Euler branch for both sides, so that per-axis differences mean something.
     e.segment<3>(3) = euler_deg_from_rotation(rotation_from_euler_deg(e[3], e[4], e[5]));
     const double end = mean_endpoint_distance(model.link_endpoints(e), truth_ends);
-    if (end >= best_end) continue;
+    // The first equivalent is always taken, so that an error that is not
+    // finite is reported as such, never as the default of 0.
+    if (k > 0 && !(end < best_end)) continue;
     best_end = end;
     FrameErrors f;
     f.symmetry_k = k;

@@ -39,6 +39,8 @@ bool parse_number(const std::string& s, double& v) {
 
 }  // namespace
 
+constexpr double kMaxPoseCell = 1e6;
+
 // A truth must be finite in every pose and joint cell; an estimate's lost
 // frame may be null.
 static PoseTable read_table(const std::filesystem::path& file, bool finite) {
@@ -93,6 +95,13 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
       if (finite && !std::isfinite(row.h[d])) {
         throw InputError(where + "expected a finite number for '" + names[d + 1] + "' in a ground truth (frame " +
                          std::to_string(row.frame) + ")");
+      }
+      // A kilometre or a thousand turns is no pose of a micro-gripper, and
+      // larger values overflow the error figures.
+      if (std::abs(row.h[d]) > kMaxPoseCell) {
+        throw InputError(where + "'" + names[d + 1] + "' = " + cells[idx[d + 1]].substr(0, 32) +
+                         " is not a plausible pose value (expected a magnitude up to 1e6 " +
+                         (d < 3 ? "mm" : "deg") + ")");
       }
     }
     if (status_col >= 0) {
