@@ -577,14 +577,58 @@ TEST(Fault, ResumeRefusesADamagedStateWithFileAndLine) {
     expect_refusal_naming(track_error(r, again), what);
     EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), 3u);
   };
-  std::ofstream(state) << text.substr(0, text.find("last ")) << "last 1 2 nan\n";
+  // The state with its line that starts with `key` replaced (or dropped).
+  const auto with_line = [&](const std::string& key, const std::string& line) {
+    const size_t at = text.find("\n" + key) + 1, end = text.find('\n', at) + 1;
+    return text.substr(0, at) + line + text.substr(end);
+  };
+  std::ofstream(state) << with_line("last ", "last 1 2 nan\n");
   expect_refusal("tracker_state.txt:6: 'nan' is not a finite number");
-  std::ofstream(state) << text.substr(0, text.find("last ")) << "last 1 2 3\n";
+  std::ofstream(state) << with_line("last ", "last 1 2 3\n");
   expect_refusal("holds a configuration of 3 values, this setup has 12; cannot resume");
+  std::ofstream(state) << with_line("lost ", "");
+  expect_refusal("missing the 'lost' line of a tracker state");
   std::ofstream(state) << "frame 2\n";
   expect_refusal("tracker_state.txt:1: expected 'gtrack-tracker-state 1'");
-  std::ofstream(state) << text.replace(text.find("frame 2"), 7, "frame 6");
+  std::ofstream(state) << with_line("frame ", "frame 6\n");
   expect_refusal("its rows end at frame 2, the tracker state at frame 6");
+  std::ofstream(state) << text;
+  fs::remove(state);
+  fs::create_directory(state);
+  expect_refusal("tracker_state.txt: is a folder; expected a tracker state file");
+  fs::remove(state);
+  std::ofstream(state) << text;
+}
+
+// The two estimate files must hold the same rows up to the state's frame:
+// one cut short, or a row that is no row, is refused by file and line, and
+// neither file is changed.
+TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
+  const fs::path dir = fresh_dir("resume_rows");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  o.range.last = 3;
+  gtrack::track_sequence(r.setup, r.config, o);
+  const fs::path csv = o.out_dir / "estimates.csv", jsonl = o.out_dir / "estimates.jsonl";
+  const std::string csv_text = read_text(csv), jsonl_text = read_text(jsonl);
+  gtrack::TrackOptions again = o;
+  again.range.last = -1;
+  again.resume = true;
+  // The JSONL cut after its first row.
+  std::ofstream(jsonl) << jsonl_text.substr(0, jsonl_text.find('\n') + 1);
+  expect_refusal_naming(track_error(r, again), "estimates.jsonl: its rows end at frame 0, the tracker state at frame 2");
+  EXPECT_EQ(read_text(csv), csv_text);
+  fs::remove(jsonl);
+  expect_refusal_naming(track_error(r, again), "estimates.jsonl: missing, while estimates.csv has rows");
+  std::ofstream(jsonl) << jsonl_text;
+  // A damaged row in the middle of the CSV is named by its line.
+  const size_t second = csv_text.find('\n', csv_text.find('\n') + 1) + 1;
+  std::ofstream(csv) << csv_text.substr(0, second) << "garbage,row,here\n" << csv_text.substr(csv_text.find('\n', second) + 1);
+  expect_refusal_naming(track_error(r, again), "estimates.csv:3: expected a row that starts with a frame index, got 'garbage,row,here'");
+  std::ofstream(csv) << csv_text;
+  EXPECT_EQ(track_error(r, again), "");
+  EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(read_lines(jsonl).size(), 8u);
 }
 
 // A plugin whose factory throws: the executable exits non-zero with one line

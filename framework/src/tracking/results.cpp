@@ -35,7 +35,10 @@ std::string csv_header(int fingers) { return pose_table_header(fingers, {"cost",
 
 // Whole lines only: a last line without its newline was cut short.
 std::vector<std::string> complete_lines(const fs::path& p) {
+  std::error_code ec;
+  if (fs::is_directory(p, ec)) throw InputError(p.string() + ": is a folder; expected a file of estimates");
   std::ifstream in(p, std::ios::binary);
+  if (!in) throw InputError(p.string() + ": cannot open");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::vector<std::string> lines;
   size_t start = 0;
@@ -216,27 +219,38 @@ std::vector<int> resume_results(const fs::path& out_dir, int fingers, int last) 
     throw InputError(csv.string() + ":1: expected the header '" + csv_header(fingers) +
                      "' (a gripper with " + std::to_string(fingers) + " fingers); cannot resume");
   }
-  std::vector<std::string> kept{rows[0]};
-  std::vector<int> frames;
-  for (size_t i = 1; i < rows.size(); ++i) {
-    const int f = row_frame(rows[i], "");
-    if (f < 0 || f > last) break;
-    kept.push_back(rows[i]);
-    frames.push_back(f);
-  }
-  if (frames.empty() || frames.back() != last) {
-    throw InputError(csv.string() + ": its rows end at frame " + (frames.empty() ? std::string("(none)") : std::to_string(frames.back())) +
-                     ", the tracker state at frame " + std::to_string(last) + "; cannot resume");
+  // The rows up to the state's frame are kept; both files must hold the
+  // same frames, or the two would no longer agree once the run goes on.
+  const auto rows_until_state = [last](const fs::path& file, const std::vector<std::string>& lines, size_t first,
+                                       const std::string& prefix, std::vector<int>& frames) {
+    std::vector<std::string> kept(lines.begin(), lines.begin() + static_cast<std::ptrdiff_t>(first));
+    for (size_t i = first; i < lines.size(); ++i) {
+      const int f = row_frame(lines[i], prefix);
+      if (f < 0) {
+        throw InputError(file.string() + ":" + std::to_string(i + 1) + ": expected a row that starts with " +
+                         (prefix.empty() ? std::string("a frame index") : "'" + prefix + "' and a frame index") + ", got '" + lines[i].substr(0, 40) + (lines[i].size() > 40 ? "...'" : "'") +
+                         "; cannot resume");
+      }
+      if (f > last) break;
+      kept.push_back(lines[i]);
+      frames.push_back(f);
+    }
+    if (frames.empty() || frames.back() != last) {
+      throw InputError(file.string() + ": its rows end at frame " +
+                       (frames.empty() ? std::string("(none)") : std::to_string(frames.back())) +
+                       ", the tracker state at frame " + std::to_string(last) + "; cannot resume");
+    }
+    return kept;
+  };
+  std::vector<int> frames, jframes;
+  const auto kept = rows_until_state(csv, rows, 1, "", frames);
+  if (!fs::exists(jsonl)) throw InputError(jsonl.string() + ": missing, while estimates.csv has rows; cannot resume");
+  const auto jkept = rows_until_state(jsonl, complete_lines(jsonl), 0, "{\"frame\":", jframes);
+  if (jframes != frames) {
+    throw InputError(jsonl.string() + ": holds " + std::to_string(jframes.size()) + " rows up to frame " +
+                     std::to_string(last) + ", estimates.csv " + std::to_string(frames.size()) + "; cannot resume");
   }
   rewrite(csv, kept);
-  std::vector<std::string> jkept;
-  if (fs::exists(jsonl)) {
-    for (const auto& l : complete_lines(jsonl)) {
-      const int f = row_frame(l, "{\"frame\":");
-      if (f < 0 || f > last) break;
-      jkept.push_back(l);
-    }
-  }
   rewrite(jsonl, jkept);
   return frames;
 }

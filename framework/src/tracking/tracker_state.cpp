@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -59,11 +60,13 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
     throw InputError(name + ":" + std::to_string(n) + ": " + what);
   };
   bool header = false, have_frame = false;
+  std::set<std::string> seen;
   while (std::getline(in, line)) {
     ++n;
     std::istringstream ls(line);
     std::string key;
     ls >> key;
+    if (n > 1 && !seen.insert(key).second) fail("'" + key + "' again");
     if (n == 1) {
       int version = 0;
       if (key != "gtrack-tracker-state" || !(ls >> version) || version != 1) {
@@ -128,10 +131,18 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
     n = std::max(n, 1);
     fail("incomplete tracker state (no header or no frame line)");
   }
+  // Every line is written every time: one that is missing means the file
+  // was damaged, and a default in its place would resume a different track.
+  for (const char* key :
+       {"lost", "started", "reference_area", "last", "before_last", "last_found", "found_step"}) {
+    if (!seen.count(key)) fail(std::string("missing the '") + key + "' line of a tracker state");
+  }
   return s;
 }
 
 TrackerState read_tracker_state(const fs::path& file) {
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) throw InputError(file.string() + ": is a folder; expected a tracker state file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
