@@ -1,5 +1,6 @@
 // gtrack track: the tracker over a video, an image folder or a camera.
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -112,8 +113,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
               << next << "\n";
   }
   std::FILE* report = stream ? stderr : stdout;
-  std::fprintf(report, "%d frames (%d lost), mean cost %.4f, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
-              s.frames, s.lost_frames, s.mean_cost, s.mean_ms, s.mean_times.segment_ms, s.mean_times.pso_ms,
+  char cost[32] = "n/a (no frame found)";
+  if (std::isfinite(s.mean_cost)) std::snprintf(cost, sizeof cost, "%.4f", s.mean_cost);
+  std::fprintf(report, "%d frames (%d lost), mean cost %s, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
+              s.frames, s.lost_frames, cost, s.mean_ms, s.mean_times.segment_ms, s.mean_times.pso_ms,
               s.mean_times.io_ms, s.renderer.c_str(), opt.out_dir.string().c_str());
   if (s.resumed_after >= 0) {
     std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);

@@ -212,7 +212,21 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
   EXPECT_GT(s.frames, 0);
   EXPECT_LT(s.frames, 20);
   EXPECT_EQ(rows.size(), static_cast<size_t>(s.frames));
-  EXPECT_TRUE(fs::exists(o.out_dir / "summary.json"));
+  // The run says that the video ended before the frames it declares, in
+  // the summary as well, so that a short video and a failed decode differ.
+  const std::string said = "decoding stopped at frame " + std::to_string(s.frames) + " of the 20 the video declares";
+  EXPECT_EQ(s.input_ended_early.rfind(said, 0), 0u) << s.input_ended_early;
+  EXPECT_NE(read_text(o.out_dir / "summary.json").find("\"input_ended_early\": \"" + said), std::string::npos);
+  // A whole video ends where it says.
+  fs::remove(avi);
+  {
+    cv::VideoWriter w(avi.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, {kSide, kSide});
+    for (int i = 0; i < 6; ++i) w.write(frame_image(i));
+  }
+  const auto whole = gtrack::track_sequence(r.setup, r.config, o);
+  EXPECT_EQ(whole.frames, 6);
+  EXPECT_EQ(whole.input_ended_early, "");
+  EXPECT_NE(read_text(o.out_dir / "summary.json").find("\"input_ended_early\": null"), std::string::npos);
 }
 
 // A folder whose image becomes unreadable part way: the run stops at that

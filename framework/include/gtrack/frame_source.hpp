@@ -49,6 +49,9 @@ class GTRACK_API FrameSource {
   // Frames in the source, or -1 when unknown (live camera).
   virtual int frame_count() const = 0;
   virtual std::string description() const = 0;
+  // Once next() has ended: why the source ended before the frames it
+  // declared (a video the decoder gave up on part way), or "" when it did not.
+  virtual std::string ended_early() const { return {}; }
 };
 
 // A folder that acquisition software is still writing images into: once

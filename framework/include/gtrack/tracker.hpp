@@ -195,7 +195,7 @@ struct TrackOptions {
 struct TrackSummary {
   int frames = 0;
   int lost_frames = 0;
-  double mean_cost = 0;      // over frames not lost
+  double mean_cost = 0;      // over frames not lost (NaN when every frame was lost)
   double mean_ms = 0;        // tracker time per frame
   StageTimes mean_times;     // per stage, per frame
   double wall_s = 0;
@@ -204,6 +204,7 @@ struct TrackSummary {
   std::filesystem::path overlay_file;  // empty if none was written
   int resumed_after = -1;    // --resume: the last frame done before this run (-1: a fresh run)
   int frames_before = 0;     // --resume: rows kept from before; `frames` counts this run's only
+  std::string input_ended_early;  // FrameSource::ended_early: "" when the input ended where it said it would
 };
 
 // Runs the tracker over a source and writes, in options.out_dir:

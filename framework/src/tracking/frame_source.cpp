@@ -86,13 +86,18 @@ class VideoSource final : public FrameSource {
   std::optional<Frame> next() override {
     for (;;) {
       if (filter_.done(index_)) return std::nullopt;
+      // The decoder's complaints are taken aside: said once, on one line,
+      // when the video ends before its declared frames.
+      detail::CapturedStderr decoder;
       if (!filter_.wanted(index_)) {
-        if (!cap_.grab()) return end_of_stream();
+        if (!cap_.grab()) return end_of_stream(decoder.take());
+        note(decoder.take());
         ++index_;
         continue;
       }
       cv::Mat img;
-      if (!cap_.read(img) || img.empty()) return end_of_stream();
+      if (!cap_.read(img) || img.empty()) return end_of_stream(decoder.take());
+      note(decoder.take());
       Frame f;
       f.index = index_++;
       f.time_s = fps_ > 0 ? f.index / fps_ : 0.0;
@@ -106,14 +111,27 @@ class VideoSource final : public FrameSource {
   double fps() const override { return fps_; }
   int frame_count() const override { return count_; }
   std::string description() const override { return name_; }
+  std::string ended_early() const override { return ended_early_; }
   // Whether the source was positioned by seeking (`seek`, and the decoder took it).
   bool seeked() const { return seeked_; }
 
  private:
-  std::optional<Frame> end_of_stream() {
+  void note(const std::string& said) {
+    if (said.empty()) return;
+    logger().debug("{} frame {}: the decoder said: {}", name_, index_, said);
+    if (last_said_.empty()) last_said_ = said;
+  }
+  std::optional<Frame> end_of_stream(const std::string& said) {
     // A video that opens but yields nothing is as unusable as one that does not open.
     if (index_ == 0 && delivered_ == 0 && !live_) {
-      throw InputError(name_ + ": no frame could be decoded (corrupt or unsupported video)");
+      throw InputError(name_ + ": no frame could be decoded (corrupt or unsupported video" +
+                       (said.empty() ? std::string(")") : "; the decoder said: " + said + ")"));
+    }
+    if (!live_ && count_ > 0 && index_ < count_ && ended_early_.empty()) {
+      const std::string why = !said.empty() ? said : last_said_;
+      ended_early_ = "decoding stopped at frame " + std::to_string(index_) + " of the " + std::to_string(count_) +
+                     " the video declares" + (why.empty() ? std::string() : " (the decoder said: " + why + ")");
+      logger().warn("{}: {}; the frames before it are tracked", name_, ended_early_);
     }
     return std::nullopt;
   }
@@ -127,6 +145,8 @@ class VideoSource final : public FrameSource {
   int index_ = 0;
   int delivered_ = 0;
   bool seeked_ = false;
+  std::string last_said_;
+  std::string ended_early_;
 };
 
 // Name order with runs of digits compared as numbers ("img2" < "img10");

@@ -24,6 +24,24 @@ std::string num(double v, const char* fmt) {
   return buf;
 }
 
+// A JSON string literal of free text (a decoder's message, a file name).
+std::string json_string(const std::string& text) {
+  std::string s = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      s += '\\';
+      s += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      s += buf;
+    } else {
+      s += c;
+    }
+  }
+  return s + "\"";
+}
+
 std::ofstream open_for_writing(const fs::path& p, bool append) {
   std::ofstream out(p, append ? std::ios::app : std::ios::trunc);
   if (!out) throw InputError(p.string() + ": cannot open for writing");
@@ -155,10 +173,12 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
       << "  \"wall_s\": " << num(s.wall_s, "%.3f") << ",\n"
       << "  \"frames_per_s\": " << num(fps, "%.3f") << ",\n"
       << "  \"renderer\": \"" << s.renderer << "\",\n"
-      << "  \"overlay\": \"" << s.overlay_file.filename().string() << "\",\n"
+      << "  \"overlay\": " << json_string(s.overlay_file.filename().string()) << ",\n"
       << "  \"resumed_after_frame\": " << (s.resumed_after >= 0 ? std::to_string(s.resumed_after) : "null") << ",\n"
       << "  \"frames_before_resume\": " << s.frames_before << ",\n"
-      << "  \"cancelled\": " << (s.cancelled ? "true" : "false") << "\n"
+      << "  \"cancelled\": " << (s.cancelled ? "true" : "false") << ",\n"
+      << "  \"input_ended_early\": " << (s.input_ended_early.empty() ? "null" : json_string(s.input_ended_early))
+      << "\n"
       << "}\n";
   if (!out) throw InputError(file.string() + ": write failed");
 }

@@ -3,8 +3,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -317,7 +317,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
 
   const int n = std::max(1, summary.frames);
   const int found = summary.frames - summary.lost_frames;
-  summary.mean_cost = found > 0 ? cost_sum / found : 0.0;
+  summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
+  summary.input_ended_early = source->ended_early();
   summary.mean_ms = ms_sum / n;
   summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
   summary.wall_s = seconds_since(start);
