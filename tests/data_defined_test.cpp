@@ -114,6 +114,40 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
             std::string::npos);
   // Adjacency naming a finger that does not exist.
   EXPECT_NE(config_error(kFourFinger + "adjacent = [[1, 5]]\n").find("adjacent"), std::string::npos);
+  // A pair that is no pair of whole fingers, or a finger paired with itself
+  // (top-level keys, so before the first [[finger]]).
+  const auto with_adjacent = [](const std::string& pairs) {
+    std::string t = kFourFinger;
+    return t.insert(t.find("[[finger]]"), "adjacent = " + pairs + "\n");
+  };
+  EXPECT_EQ(config_error(with_adjacent("[[1, 2], [2, 3], [3, 4], [4, 1]]")), "");
+  std::string half = config_error(with_adjacent("[[1.5, 2]]"));
+  EXPECT_NE(half.find("key 'adjacent': expected pairs of whole finger numbers"), std::string::npos) << half;
+  std::string self = config_error(with_adjacent("[[2, 2]]"));
+  EXPECT_NE(self.find("key 'adjacent': a finger cannot be adjacent to itself"), std::string::npos) << self;
+  // Sizes no micro-gripper has: refused with the key and the bound.
+  std::string huge = kFourFinger;
+  huge.replace(huge.find("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 1e300]");
+  const std::string h = config_error(huge);
+  EXPECT_NE(h.find("finger[0].link_lengths_mm': element 2 (1e+300) is out of range; expected a number in (0, 100]"),
+            std::string::npos)
+      << h;
+  std::string far = kFourFinger;
+  far.replace(far.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.2, 500]");
+  EXPECT_NE(config_error(far).find("finger[0].base_mm"), std::string::npos) << config_error(far);
+}
+
+// More links than the renderers have slots for: refused when the model is
+// made (so synth refuses it as track does), naming the count and the limit.
+TEST(DataDefinedGripper, TooManyLinksIsRefusedAtLoad) {
+  const std::string ok = "plugin = \"data_defined\"\n[radial]\nfingers = 64\npalm_circumradius_mm = 1\n"
+                         "link_lengths_mm = [0.1, 0.1, 0.1]\nlink_widths_mm = [0.05, 0.05, 0.05, 0]\n";
+  EXPECT_EQ(config_error(ok), "");  // 192 links
+  std::string over = ok;
+  over.replace(over.find("[0.1, 0.1, 0.1]"), 15, "[0.1, 0.1, 0.1, 0.1]");
+  over.replace(over.find("[0.05, 0.05, 0.05, 0]"), 21, "[0.05, 0.05, 0.05, 0.05, 0]");
+  const std::string e = config_error(over);
+  EXPECT_NE(e.find("256 links over its 64 fingers; at most 255 are supported"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -409,7 +409,7 @@ TEST(TrackSequence, CancellationKeepsValidFiles) {
   EXPECT_EQ(lines(opt.out_dir / "estimates.csv").size(), 3u);
   EXPECT_EQ(lines(opt.out_dir / "estimates.jsonl").size(), 2u);
   const auto summary = lines(opt.out_dir / "summary.json");
-  EXPECT_NE(std::find(summary.begin(), summary.end(), "  \"cancelled\": true"), summary.end());
+  EXPECT_NE(std::find(summary.begin(), summary.end(), "  \"cancelled\": true,"), summary.end());
 }
 
 // SIGINT to a real `gtrack track` process: it finishes the frame, closes the

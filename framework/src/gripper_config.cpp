@@ -7,10 +7,11 @@ namespace gtrack {
 
 GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDefaults d) {
   RadialGripperSpec spec = d.spec;
-  spec.palm_circumradius_mm = t.number_or("palm_circumradius_mm", spec.palm_circumradius_mm, Range::positive());
+  const Range size{0.0, ArticulatedModel::kMaxSizeMm, true, false};
+  spec.palm_circumradius_mm = t.number_or("palm_circumradius_mm", spec.palm_circumradius_mm, size);
   std::vector<double> lengths;
   for (const auto& l : spec.links) lengths.push_back(l.length_mm);
-  lengths = t.numbers_or("link_lengths_mm", lengths, std::nullopt, Range::positive());
+  lengths = t.numbers_or("link_lengths_mm", lengths, std::nullopt, size);
   if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
   const bool lengths_changed = lengths.size() != d.widths_mm.size() - 1;
   // The built-in widths fit the built-in number of links only.
@@ -21,7 +22,7 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
                                  std::to_string(d.widths_mm.size() - 1) + " links)");
   }
   std::vector<double> widths =
-      t.numbers_or("link_widths_mm", d.widths_mm, lengths.size() + 1, Range::non_negative());
+      t.numbers_or("link_widths_mm", d.widths_mm, lengths.size() + 1, Range::closed(0, ArticulatedModel::kMaxSizeMm));
   spec.links.clear();
   for (size_t j = 0; j < lengths.size(); ++j) spec.links.push_back({lengths[j], widths[j], widths[j + 1]});
 

@@ -1,7 +1,9 @@
 // ArticulatedModel: the mesh, posing, K(H) and rotational symmetry.
 #include "gtrack/model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "gtrack/error.hpp"
@@ -66,6 +68,25 @@ ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) 
   for (auto [a, b] : G.collision.adjacent) {
     if (a < 0 || b < 0 || a >= fingers() || b >= fingers())
       throw Error("gripper '" + G.name + "': adjacency names a finger that does not exist");
+    if (a == b) throw Error("gripper '" + G.name + "': a finger cannot be adjacent to itself");
+  }
+  int links = 0;
+  double extent = 0;
+  for (const auto& F : G.fingers) {
+    links += static_cast<int>(F.links.size());
+    extent = std::max(extent, F.base_mm.norm());
+    for (const auto& l : F.links) extent = std::max({extent, l.length_mm, l.width_start_mm, l.width_end_mm});
+  }
+  for (const auto& p : G.palm_mm) extent = std::max(extent, p.norm());
+  if (links > kMaxLinks) {
+    throw Error("gripper '" + G.name + "': " + std::to_string(links) + " links over its " +
+                std::to_string(fingers()) + " fingers; at most " + std::to_string(kMaxLinks) + " are supported");
+  }
+  if (!(extent <= kMaxSizeMm)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "a part is %g mm long or away from the palm centre; at most %g mm is supported",
+                  extent, kMaxSizeMm);
+    throw Error("gripper '" + G.name + "': " + text);
   }
 
   // Palm: a fan over the convex polygon.

@@ -68,6 +68,11 @@ struct GripperGeometry {
 
 class GTRACK_API ArticulatedModel {
  public:
+  // Links over all fingers, and the largest extent of any part (mm): a
+  // model past either is refused by the constructor.
+  static constexpr int kMaxLinks = 255;
+  static constexpr double kMaxSizeMm = 100;
+
   ArticulatedModel() = default;
   // Validates the geometry; throws gtrack::Error saying what is wrong.
   explicit ArticulatedModel(GripperGeometry geometry);

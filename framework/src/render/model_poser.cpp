@@ -11,7 +11,7 @@ namespace gtrack::render {
 
 namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr int kMaxSlots = 256;  // palm + links over all fingers; checked in the constructor
+constexpr int kMaxSlots = ArticulatedModel::kMaxLinks + 1;  // palm + links over all fingers
 constexpr int kRows = 3 + kMaxSensorPlanes;
 
 }  // namespace
@@ -30,10 +30,8 @@ ModelPoser::ModelPoser(const ArticulatedModel& model) : dims_(model.dims()) {
     }
     fingers_.push_back(std::move(F));
   }
-  if (slot_finger_.size() > kMaxSlots) {
-    throw Error("gripper '" + g.name + "' has more than " + std::to_string(kMaxSlots - 1) +
-                " links in all; the cpu backend supports up to that");
-  }
+  // ArticulatedModel refuses more links than there are slots.
+  if (slot_finger_.size() > kMaxSlots) throw Error("gripper '" + g.name + "': too many links for the cpu backend");
   for (const ModelVertex& m : model.mesh()) {
     const int slot = m.finger < 0 ? 0 : fingers_[m.finger].first_slot + m.link;
     vertices_.push_back({static_cast<double>(m.a), static_cast<double>(m.b), slot});

@@ -12,6 +12,7 @@
 //   (1-based; default: each finger with the next, around);
 //   max_adjacent_difference_deg, max_adjacent_sum_deg; symmetry_order;
 //   unfolded_deg, folded_deg.
+#include <cmath>
 #include <filesystem>
 #include <gtrack/error.hpp>
 #include <gtrack/plugin.hpp>
@@ -21,10 +22,14 @@ namespace {
 using gtrack::ConfigTable;
 using gtrack::Range;
 
+constexpr double kMaxMm = gtrack::ArticulatedModel::kMaxSizeMm;
+const Range kLength{0.0, kMaxMm, true, false};  // (0, 100] mm
+const Range kPlace = Range::closed(-kMaxMm, kMaxMm);
+
 std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
-  const auto lengths = t.numbers("link_lengths_mm", std::nullopt, Range::positive());
+  const auto lengths = t.numbers("link_lengths_mm", std::nullopt, kLength);
   if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
-  const auto widths = t.numbers("link_widths_mm", lengths.size() + 1, Range::non_negative());
+  const auto widths = t.numbers("link_widths_mm", lengths.size() + 1, Range::closed(0, kMaxMm));
   std::vector<gtrack::LinkShape> links;
   for (size_t j = 0; j < lengths.size(); ++j) {
     if (widths[j] <= 0 && widths[j + 1] <= 0) t.fail("link_widths_mm", "a link needs a width at one end at least");
@@ -47,13 +52,13 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
     const int sides = spec.fingers * ((3 + spec.fingers - 1) / spec.fingers);
     spec.palm_sides = static_cast<int>(r.integer_or("palm_sides", sides, Range{3, 256}));
     if (spec.palm_sides % spec.fingers != 0) r.fail("palm_sides", "must be a multiple of fingers");
-    spec.palm_circumradius_mm = r.number("palm_circumradius_mm", Range::positive());
+    spec.palm_circumradius_mm = r.number("palm_circumradius_mm", kLength);
     spec.finger_phase_deg = r.number_or("phase_deg", 0.0);
     spec.links = read_links(r);
     r.check_all_used();
     g = gtrack::make_radial_gripper(spec);
   } else {
-    for (const auto& p : t.number_rows("palm_mm", 2)) g.palm_mm.emplace_back(p[0], p[1]);
+    for (const auto& p : t.number_rows("palm_mm", 2, kPlace)) g.palm_mm.emplace_back(p[0], p[1]);
     if (g.palm_mm.size() < 3) t.fail("palm_mm", "the palm needs at least 3 points");
     double area = 0;
     for (size_t i = 0; i < g.palm_mm.size(); ++i) {
@@ -66,7 +71,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
     if (fingers.empty()) t.fail("finger", "missing; add one [[finger]] table per finger (or use [radial])");
     for (const auto& f : fingers) {
       gtrack::FingerShape F;
-      auto b = f.numbers("base_mm", 2);
+      auto b = f.numbers("base_mm", 2, kPlace);
       F.base_mm = {b[0], b[1]};
       F.direction_deg = f.number("direction_deg", Range::closed(-360, 360));
       F.links = read_links(f);
@@ -79,6 +84,10 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   if (t.has("adjacent")) {
     g.collision.adjacent.clear();
     for (const auto& p : t.number_rows("adjacent", 2, Range::closed(1, static_cast<double>(g.fingers.size())))) {
+      if (p[0] != std::floor(p[0]) || p[1] != std::floor(p[1])) {
+        t.fail("adjacent", "expected pairs of whole finger numbers (1-based)");
+      }
+      if (p[0] == p[1]) t.fail("adjacent", "a finger cannot be adjacent to itself");
       g.collision.adjacent.emplace_back(static_cast<int>(p[0]) - 1, static_cast<int>(p[1]) - 1);
     }
   }
