@@ -77,7 +77,7 @@ std::unique_ptr<gtrack::Renderer> try_make(Make make, int threads, std::string& 
 
 int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   const double seconds = vm["seconds"].as<double>();
-  if (!(seconds > 0)) throw gtrack::cli::UsageError("--seconds must be positive");
+  if (!(seconds > 0 && seconds <= 3600)) throw gtrack::cli::UsageError("--seconds must be in (0, 3600]");
   const bool json = vm.count("json") > 0;
   const int all = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 

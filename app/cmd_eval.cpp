@@ -1,5 +1,6 @@
 // gtrack eval: estimates against ground truth (paper Section 5.1 metrics).
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -150,6 +151,10 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   const fs::path truth_file = vm["truth"].as<std::string>();
   const fs::path estimates_file = vm["estimates"].as<std::string>();
   for (const fs::path& f : {truth_file, estimates_file}) {
+    if (fs::is_directory(f)) {
+      throw gtrack::InputError(f.string() + ": is a folder; expected a pose table (" +
+                               (f == truth_file ? "ground_truth.csv" : "estimates.csv") + ")");
+    }
     if (!fs::is_regular_file(f)) throw gtrack::InputError(f.string() + ": no such file");
   }
   // Where the results go is checked before anything is computed.
@@ -176,7 +181,9 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   if (!(opt.out_of_view_below >= 0 && opt.out_of_view_below < 1)) {
     throw gtrack::cli::UsageError("--out-of-view-below must be a share in [0, 1)");
   }
-  if (!(opt.off_track_endpoint_um > 0)) throw gtrack::cli::UsageError("--off-track-um must be positive");
+  if (!(opt.off_track_endpoint_um > 0 && std::isfinite(opt.off_track_endpoint_um))) {
+    throw gtrack::cli::UsageError("--off-track-um must be a positive number");
+  }
   const auto truth = gtrack::read_truth_table(truth_file);
   const auto estimates = gtrack::read_pose_table(estimates_file);
   for (const auto* t : {&truth, &estimates}) {

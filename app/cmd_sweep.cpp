@@ -218,7 +218,15 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   check(sigmas, 0, 90, false, "sigmas", "degrees");
   if (vm["fig6b-particles"].as<int>() < 2) throw gtrack::cli::UsageError("--fig6b-particles must be at least 2");
   if (vm["fig6b-generations"].as<int>() < 1) throw gtrack::cli::UsageError("--fig6b-generations must be at least 1");
-  fs::create_directories(c.out);
+  // The config is checked, as track checks it, before anything is made:
+  // its errors name the user's file, not a sequence made from it.
+  {
+    gtrack::SetupOptions so;
+    so.plugin_paths = c.common.plugin_paths;
+    const gtrack::Setup setup = gtrack::load_setup(c.config, so);
+    (void)gtrack::engine_config(setup);
+  }
+  gtrack::cli::make_output_folder(c.out, "out");
 
   if (which != "6b") {
     std::ofstream csv(c.out / "fig6a.csv");

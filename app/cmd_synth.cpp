@@ -20,7 +20,9 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   o.threads = vm["threads"].as<int>();
   if (o.threads < 0) throw gtrack::cli::UsageError("--threads must be 0 (all cores) or more");
   if (o.frames < 1) throw gtrack::cli::UsageError("--frames must be at least 1");
-  if (o.joint_noise_deg < 0) throw gtrack::cli::UsageError("--joint-noise must not be negative");
+  if (!(o.joint_noise_deg >= 0 && o.joint_noise_deg <= 90)) {
+    throw gtrack::cli::UsageError("--joint-noise must be a number of degrees in [0, 90]");
+  }
   if (!(o.occlusion_scale >= 0 && o.occlusion_scale <= 1)) {
     throw gtrack::cli::UsageError("--occlusion-scale must be in [0, 1]");
   }

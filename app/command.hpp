@@ -54,7 +54,25 @@ inline void check_output_folder(const std::filesystem::path& file, const std::st
   const std::filesystem::path dir = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) {
-    throw gtrack::InputError(file.string() + ": the folder '" + dir.string() + "' does not exist" +
+    const bool exists = std::filesystem::exists(dir, ec);
+    throw gtrack::InputError(file.string() + ": '" + dir.string() + "' " +
+                             (exists ? "is not a folder" : "does not exist") +
+                             (option.empty() ? std::string() : " (--" + option + ")"));
+  }
+  if (std::filesystem::is_directory(file, ec)) {
+    throw gtrack::InputError(file.string() + ": is a folder; expected a file name" +
+                             (option.empty() ? std::string() : " (--" + option + ")"));
+  }
+}
+
+// A folder to write into, made if missing: a path under a regular file or
+// one that cannot be made is one line naming it.
+inline void make_output_folder(const std::filesystem::path& dir, const std::string& option = "") {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir)) {
+    throw gtrack::InputError(dir.string() + ": cannot create the folder (" +
+                             (ec ? ec.message() : std::string("a file of that name exists")) + ")" +
                              (option.empty() ? std::string() : " (--" + option + ")"));
   }
 }

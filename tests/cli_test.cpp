@@ -326,7 +326,12 @@ TEST(Cli, RenderChecksTheConfigAndItsOutputsFirst) {
   r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o mask.jpgx");
   expect_refusal(r, "mask.jpgx: cannot write images of this kind");
   r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o no_such_folder/mask.png");
-  EXPECT_NE(r.output.find("the folder 'no_such_folder' does not exist"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no_such_folder/mask.png: 'no_such_folder' does not exist"), std::string::npos) << r.output;
+  // A file where the folder should be, and a folder where the file should be.
+  r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + ok.string() + "/mask.png");
+  EXPECT_NE(r.output.find("' is not a folder"), std::string::npos) << r.output;
+  r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + ok.parent_path().string());
+  EXPECT_NE(r.output.find(": is a folder; expected a file name"), std::string::npos) << r.output;
 }
 
 // A frame folder with a damaged image: the decoder's own words go into the
@@ -549,6 +554,32 @@ TEST(Cli, UsageErrors) {
   CliRun v = gtrack("--version");
   EXPECT_EQ(v.code, 0);
   EXPECT_NE(v.output.find("gtrack "), std::string::npos);
+  // Numbers out of their range, NaN included, are refused before any work.
+  const fs::path out = fs::temp_directory_path() / "gtrack_cli_test" / "usage";
+  CliRun r = gtrack("synth --joint-noise nan --frames 2 --out " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--joint-noise must be a number of degrees in [0, 90]"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  r = gtrack("bench --seconds 1e300");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--seconds must be in (0, 3600]"), std::string::npos) << r.output;
+}
+
+// sweep checks its config and its output folder before it makes any
+// sequence: an error names the user's file, not one made from it.
+TEST(Cli, SweepChecksItsConfigAndFolderFirst) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "sweep_bad";
+  fs::remove_all(dir);
+  const fs::path cfg = write("sweep_bad.toml", hydrogel_config() + "\n[pso]\nparticles = -5\n");
+  const std::string tiny = " --particles 4 --generations 2 --sigmas 0 --frames 2 --figure 6a";
+  CliRun r = gtrack("sweep --config " + cfg.string() + tiny + " --out " + dir.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find(cfg.string() + ":"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("key 'pso.particles'"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir));
+  r = gtrack("sweep" + tiny + " --out " + cfg.string() + "/x");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find(cfg.string() + "/x: cannot create the folder"), std::string::npos) << r.output;
 }
 
 }  // namespace
