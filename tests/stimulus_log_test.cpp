@@ -40,7 +40,16 @@ TEST(StimulusLog, TimeKeyedUsesFrameTime) {
 TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
   EXPECT_EQ(error_of("frame,temp\n"), "log.csv:1: expected the header 'frame,value' or 'time_s,value', got 'frame,temp'");
   EXPECT_EQ(error_of("frame,value\n0,20\n1,abc\n"), "log.csv:3: expected a number in the value field, got 'abc'");
-  EXPECT_EQ(error_of("frame,value\n0,20\n1.5,21\n"), "log.csv:3: expected a frame index in the first field, got '1.5'");
+  EXPECT_EQ(error_of("frame,value\n0,20\n1.5,21\n"),
+            "log.csv:3: expected a frame index (a whole number from 0 to 2147483647) in the first field, got '1.5'");
+  EXPECT_EQ(error_of("frame,value\n0,20\n99999999999999999999999,21\n"),
+            "log.csv:3: expected a frame index (a whole number from 0 to 2147483647) in the first field, got "
+            "'99999999999999999999999'");
+  // Long or binary fields are quoted short and printable.
+  EXPECT_EQ(error_of("frame,value\n0," + std::string(100, 'A') + "\n"),
+            "log.csv:2: expected a number in the value field, got '" + std::string(60, 'A') + "...' (100 characters)");
+  EXPECT_EQ(error_of(std::string("frame,value\n0,\x01\xff\n")),
+            "log.csv:2: expected a number in the value field, got '\\x01\\xFF'");
   EXPECT_EQ(error_of("frame,value\n3,20\n2,21\n"),
             "log.csv:3: expected a frame index greater than the previous row's, got '2'");
   EXPECT_EQ(error_of("time_s,value\n0.5\n"), "log.csv:2: expected two fields '<time_s>,<value>', got '0.5'");
@@ -50,6 +59,28 @@ TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
 
 TEST(StimulusLog, MissingFileIsAnInputError) {
   EXPECT_THROW(StimulusLog::load("/nonexistent/stimulus.csv"), gtrack::InputError);
+}
+
+// A file that never ends a line is refused at a bounded length, not read
+// into memory whole; a folder is said to be one.
+TEST(StimulusLog, ALineWithoutEndAndAFolderAreRefused) {
+  namespace fs = std::filesystem;
+  const fs::path file = fs::temp_directory_path() / "gtrack_stimulus_long.csv";
+  std::ofstream(file) << "frame,value\n0,1\n" << std::string(100000, 'x');
+  try {
+    StimulusLog::load(file);
+    FAIL() << "a 100000-character line must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() + ":3: a line longer than 4096 characters; expected 'frame,value' "
+                                                      "or 'time_s,value' rows");
+  }
+  fs::remove(file);
+  try {
+    StimulusLog::load(fs::temp_directory_path());
+    FAIL() << "a folder must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(": is a folder; expected a stimulus log"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

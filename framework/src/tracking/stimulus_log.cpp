@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -27,14 +28,52 @@ bool parse_number(const std::string& text, double& out) {
   return ec == std::errc() && end == t.data() + t.size() && std::isfinite(out);
 }
 
+// A field as it is quoted in a message: at most 60 characters, bytes that
+// are not printable ASCII as \xNN.
+std::string quoted(const std::string& text) {
+  std::string q = "'";
+  for (size_t i = 0; i < text.size() && i < 60; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      q += static_cast<char>(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", c);
+      q += buf;
+    }
+  }
+  q += text.size() > 60 ? "...' (" + std::to_string(text.size()) + " characters)" : "'";
+  return q;
+}
+
+// A row of a stimulus log is a few dozen characters.
+constexpr size_t kMaxLine = 4096;
+
 }  // namespace
 
 StimulusLog StimulusLog::load(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    throw InputError(file.string() + ": is a folder; expected a stimulus log (a CSV file)");
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open the stimulus log");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), file.string());
+  // Read a line at a time with a bound, so that a file that never ends a
+  // line (/dev/zero, a binary file) is refused instead of filling memory.
+  std::string text, line;
+  int lineno = 0;
+  for (char c; in.get(c);) {
+    line += c;
+    if (c == '\n') {
+      text += line;
+      line.clear();
+      ++lineno;
+    } else if (line.size() > kMaxLine) {
+      throw InputError(file.string() + ":" + std::to_string(lineno + 1) + ": a line longer than " +
+                       std::to_string(kMaxLine) + " characters; expected 'frame,value' or 'time_s,value' rows");
+    }
+  }
+  return parse(text + line, file.string());
 }
 
 StimulusLog StimulusLog::parse(const std::string& text, const std::string& source) {
@@ -62,7 +101,7 @@ void StimulusLog::take_line(std::string line) {
   const std::string where = source_ + ":" + std::to_string(lineno) + ": ";
   if (!header_) {
     if (comma == std::string::npos || b != "value" || (a != "frame" && a != "time_s")) {
-      throw InputError(where + "expected the header 'frame,value' or 'time_s,value', got '" + t + "'");
+      throw InputError(where + "expected the header 'frame,value' or 'time_s,value', got " + quoted(t));
     }
     key_ = a == "frame" ? Key::Frame : Key::Time;
     header_ = true;
@@ -72,14 +111,17 @@ void StimulusLog::take_line(std::string line) {
   double k = 0, v = 0;
   if (comma == std::string::npos || b.find(',') != std::string::npos) {
     throw InputError(where + "expected two fields '<" + std::string(key_ == Key::Frame ? "frame" : "time_s") +
-                     ">,<value>', got '" + t + "'");
+                     ">,<value>', got " + quoted(t));
   }
-  if (!parse_number(a, k) || (key_ == Key::Frame && (k < 0 || k != std::floor(k)))) {
-    throw InputError(where + "expected " + key_name + " in the first field, got '" + a + "'");
+  if (!parse_number(a, k) || (key_ == Key::Frame && (k < 0 || k != std::floor(k) || k > 2147483647.0))) {
+    throw InputError(where + "expected " +
+                     (key_ == Key::Frame ? std::string("a frame index (a whole number from 0 to 2147483647)")
+                                         : std::string(key_name)) +
+                     " in the first field, got " + quoted(a));
   }
-  if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got '" + b + "'");
+  if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got " + quoted(b));
   if (!keys_.empty() && !(k > keys_.back())) {
-    throw InputError(where + "expected " + key_name + " greater than the previous row's, got '" + a + "'");
+    throw InputError(where + "expected " + key_name + " greater than the previous row's, got " + quoted(a));
   }
   keys_.push_back(k);
   values_.push_back(v);
