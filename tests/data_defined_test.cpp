@@ -137,6 +137,15 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   EXPECT_NE(config_error(far).find("finger[0].base_mm"), std::string::npos) << config_error(far);
 }
 
+// A model_file that is missing or a folder is named with the key that
+// names it.
+TEST(DataDefinedGripper, AMissingModelFileNamesItsKey) {
+  const std::string missing = config_error("plugin = \"data_defined\"\nmodel_file = \"/nonexistent/m.toml\"\n");
+  EXPECT_NE(missing.find("key 'model_file': /nonexistent/m.toml does not exist"), std::string::npos) << missing;
+  const std::string folder = config_error("plugin = \"data_defined\"\nmodel_file = \"/tmp\"\n");
+  EXPECT_NE(folder.find("key 'model_file': /tmp is a folder"), std::string::npos) << folder;
+}
+
 // More links than the renderers have slots for: refused when the model is
 // made (so synth refuses it as track does), naming the count and the limit.
 TEST(DataDefinedGripper, TooManyLinksIsRefusedAtLoad) {

@@ -248,6 +248,26 @@ TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
     EXPECT_NE(std::string(e.what()).find("truth.csv:4: expected a finite number for 'q1_deg'"), std::string::npos)
         << e.what();
   }
+  // A byte-order mark before the header is skipped; a row that says it is
+  // tracked but has no configuration is refused (only a lost one may).
+  {
+    std::ofstream f(dir / "bom.csv");
+    f << "\xEF\xBB\xBF" "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,status\n0,1,2,3,4,5,6,7,ok\n"
+         "1,nan,nan,nan,nan,nan,nan,nan,lost\n";
+  }
+  EXPECT_EQ(gtrack::read_pose_table(dir / "bom.csv").rows.size(), 2u);
+  {
+    std::ofstream f(dir / "nan_ok.csv");
+    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,status\n0,1,2,3,4,5,6,7,ok\n1,1,2,nan,4,5,6,7,ok\n";
+  }
+  try {
+    gtrack::read_pose_table(dir / "nan_ok.csv");
+    FAIL() << "a NaN in a row with status ok must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nan_ok.csv:3: expected a finite number for 'z_mm' in a row whose status is ok"),
+              std::string::npos)
+        << e.what();
+  }
   // A value no micro-gripper pose can have is refused by name and line.
   {
     std::ofstream f(dir / "far.csv");

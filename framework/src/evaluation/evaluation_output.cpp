@@ -19,6 +19,8 @@ std::string num(double v) {
 }
 
 std::string stats_json(const ErrorStats& s) {
+  // No frame, no figure: null, never a perfect 0.
+  if (s.count == 0) return "{\"mean\": null, \"std\": null, \"median\": null, \"max\": null, \"count\": 0}";
   return "{\"mean\": " + num(s.mean) + ", \"std\": " + num(s.std) + ", \"median\": " + num(s.median) +
          ", \"max\": " + num(s.max) +
          ", \"count\": " + std::to_string(s.count) + "}";

@@ -44,10 +44,13 @@ constexpr double kMaxPoseCell = 1e6;
 // A truth must be finite in every pose and joint cell; an estimate's lost
 // frame may be null.
 static PoseTable read_table(const std::filesystem::path& file, bool finite) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw InputError(file.string() + ": is a folder; expected a pose table");
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot open");
   std::string line;
   if (!std::getline(in, line)) throw InputError(file.string() + ":1: empty file, expected a header line");
+  if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
   const auto header = split_csv(line);
   std::map<std::string, int> col;
   for (int i = 0; i < static_cast<int>(header.size()); ++i) col[header[i]] = i;
@@ -108,6 +111,13 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
       row.status = cells[status_col];
       if (row.status != "ok" && row.status != "search" && row.status != "lost") {
         throw InputError(where + "expected a status of ok, search or lost, got '" + row.status + "'");
+      }
+      // Only a lost frame has no configuration.
+      if (row.status != "lost" && !row.h.allFinite()) {
+        int d = 0;
+        while (std::isfinite(row.h[d])) ++d;
+        throw InputError(where + "expected a finite number for '" + names[d + 1] + "' in a row whose status is " +
+                         row.status + " (only a lost frame may have none)");
       }
     }
     for (size_t e = 0; e < extra_idx.size(); ++e) {

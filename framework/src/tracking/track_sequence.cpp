@@ -116,12 +116,15 @@ int expected_frames(const FrameSource& src, const FrameRange& r) {
 }
 
 // A pose table (--restart-from, --score-truth) for the gripper of this setup.
-PoseTable read_gripper_poses(const fs::path& file, const Setup& setup) {
-  PoseTable table = read_pose_table(file);
+// `truth`: every cell must be finite (--score-truth); a track to restart
+// from may hold lost rows, which are refused where they would be used.
+PoseTable read_gripper_poses(const fs::path& file, const Setup& setup, bool truth) {
+  PoseTable table = truth ? read_truth_table(file) : read_pose_table(file);
   if (table.fingers != setup.model().fingers()) {
     throw InputError(file.string() + ": has " + std::to_string(table.fingers) +
                      " joint columns, the gripper of this config has " + std::to_string(setup.model().fingers()));
   }
+  if (table.rows.empty()) throw InputError(file.string() + ": a header and no rows; expected a row per frame");
   return table;
 }
 
@@ -141,7 +144,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   std::map<int, Eigen::VectorXd> restart_rows;
   if (options.restart_from) {
-    const PoseTable table = read_gripper_poses(*options.restart_from, setup);
+    const PoseTable table = read_gripper_poses(*options.restart_from, setup, false);
     for (const auto& row : table.rows) {
       if (!row.h.allFinite()) {
         throw InputError(options.restart_from->string() + ": frame " + std::to_string(row.frame) +
@@ -152,10 +155,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   std::map<int, Eigen::VectorXd> reference_rows;
   if (options.score_truth) {
-    const PoseTable table = read_gripper_poses(*options.score_truth, setup);
-    for (const auto& row : table.rows) {
-      if (row.h.allFinite()) reference_rows[row.frame] = row.h;
-    }
+    const PoseTable table = read_gripper_poses(*options.score_truth, setup, true);
+    for (const auto& row : table.rows) reference_rows[row.frame] = row.h;
   }
   if (options.stimulus_csv) {
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);

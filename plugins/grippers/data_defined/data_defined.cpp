@@ -108,6 +108,9 @@ gtrack::ArticulatedModel load_model(const ConfigTable& t) {
   if (!t.has("model_file")) return gtrack::ArticulatedModel(read_geometry(t));
   std::filesystem::path file = t.string("model_file");
   if (file.is_relative() && !t.source().empty()) file = std::filesystem::path(t.source()).parent_path() / file;
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) t.fail("model_file", file.string() + " is a folder; expected a TOML file");
+  if (!std::filesystem::is_regular_file(file, ec)) t.fail("model_file", file.string() + " does not exist");
   const ConfigTable m = ConfigTable::load_file(file.string());
   gtrack::GripperGeometry g = read_geometry(m);
   m.check_all_used();
