@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <spdlog/sinks/ostream_sink.h>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -30,6 +31,7 @@
 #include "gtrack/config.hpp"
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
 #include "gtrack/tracker.hpp"
 
@@ -227,6 +229,44 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
   EXPECT_EQ(whole.frames, 6);
   EXPECT_EQ(whole.input_ended_early, "");
   EXPECT_NE(read_text(o.out_dir / "summary.json").find("\"input_ended_early\": null"), std::string::npos);
+}
+
+// Grey images for a segmentation by colour: every frame would be lost
+// without a word, so the first frame says why, once.
+TEST(Fault, GreyFramesForAColourSegmentationAreSaidOnce) {
+  const TrackRun r = make_run();
+  const auto warnings_of = [&](const fs::path& frames, const fs::path& out) {
+    std::ostringstream log;
+    gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+    gtrack::TrackOptions o;
+    o.input = frames.string();
+    o.out_dir = out;
+    o.progress = false;
+    std::string error;
+    try {
+      gtrack::track_sequence(r.setup, r.config, o);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    gtrack::logger().sinks().pop_back();
+    EXPECT_EQ(error, "");
+    return log.str();
+  };
+  const fs::path dir = fresh_dir("grey");
+  const fs::path colour = write_frames(dir / "colour", 3);
+  fs::create_directories(dir / "grey");
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat grey;
+    cv::cvtColor(frame_image(i), grey, cv::COLOR_BGR2GRAY);
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    cv::imwrite((dir / "grey" / name).string(), grey);
+  }
+  const std::string said = "a grey image, but [observation] color_space = \"hsv\" with saturation_min";
+  const std::string grey_log = warnings_of(dir / "grey", dir / "out_grey");
+  EXPECT_NE(grey_log.find("000000.png: " + said), std::string::npos) << grey_log;
+  EXPECT_EQ(grey_log.find(said), grey_log.rfind(said)) << "said once: " << grey_log;
+  EXPECT_EQ(warnings_of(colour, dir / "out_colour").find(said), std::string::npos);
 }
 
 // A folder whose image becomes unreadable part way: the run stops at that

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -126,6 +127,21 @@ PoseTable read_gripper_poses(const fs::path& file, const Setup& setup, bool trut
   }
   if (table.rows.empty()) throw InputError(file.string() + ": a header and no rows; expected a row per frame");
   return table;
+}
+
+// A grey image (its three channels equal: a grayscale or 16-bit grey file
+// read as colour) has no saturation, so a colour segmentation that needs
+// some finds nothing in it: said once, at the first frame, instead of
+// every frame coming out lost without a word.
+void warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o) {
+  if (o.color_space != "hsv" || !(o.saturation_min > 0) || frame.image.channels() != 3) return;
+  cv::Mat channels[3];
+  cv::split(frame.image, channels);
+  if (cv::countNonZero(channels[0] != channels[1]) > 0 || cv::countNonZero(channels[1] != channels[2]) > 0) return;
+  logger().warn("{}: a grey image, but [observation] color_space = \"hsv\" with saturation_min = {} finds "
+                "nothing without colour; every frame will be lost (for grey images use color_space = "
+                "\"luminance\")",
+                frame.name, o.saturation_min);
 }
 
 }  // namespace
@@ -280,6 +296,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
       if (row != restart_rows.end()) tracker.set_estimate(row->second);
     }
+    if (summary.frames == 0) warn_if_grey_for_colour(*frame, config.observation);
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
     previous_index = frame->index;
     if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
