@@ -700,22 +700,13 @@ TEST(Fault, ThrowingPluginFactoryIsOneLineFromTheExecutable) {
   EXPECT_FALSE(fs::exists(dir / "m.png"));
 }
 
-// NaN and infinity are valid TOML; no numeric key may accept them. Each is a
-// ConfigError naming file, line and key, raised before any frame is read.
-TEST(Fault, NonFiniteConfigValuesAreRefusedWithFileLineKey) {
-  struct Case {
-    std::string table, key, value;
-  };
-  const std::vector<Case> cases = {
-      {"sensor", "fx", "inf"},          {"sensor", "cx", "nan"},
-      {"gripper", "joint_max_deg", "inf"}, {"stimulus", "fold_above_C", "nan"},
-      {"pso", "inertia", "nan"},        {"cost", "lambda_dice", "inf"},
-      {"cost", "lambda_kinematic", "-nan"}, {"render", "scale", "nan"},
-      {"observation", "prior_sigma_px", "inf"}, {"search", "position_min_mm", "[-inf, 0.0, 90.0]"},
-      {"tracker", "initial_pose", "[0, 0, nan, 0, 0, 0, 0, 0, 0, 0, 0, 0]"},
-      {"tracker", "default_stimulus", "nan"}, {"tracker", "fps", "inf"},
-      {"cost", "occlusion_growth_weight", "nan"},
-  };
+struct KeyCase {
+  std::string table, key, value;
+};
+
+// Each case is a ConfigError naming file, line and key, raised before any
+// frame is read.
+void expect_each_refused(const std::vector<KeyCase>& cases) {
   for (const auto& c : cases) {
     // Replace the key if the base config has it, else add it to its table.
     std::string text = kConfig;
@@ -736,16 +727,45 @@ TEST(Fault, NonFiniteConfigValuesAreRefusedWithFileLineKey) {
     }
     SCOPED_TRACE("[" + c.table + "] " + c.key + " = " + c.value);
     try {
-      const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "nan.toml"), {});
+      const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "bad.toml"), {});
       (void)gtrack::engine_config(setup);
       FAIL() << "accepted";
     } catch (const gtrack::Error& e) {
       const std::string m = e.what();
       EXPECT_TRUE(one_line(m)) << m;
-      EXPECT_EQ(m.rfind("nan.toml:", 0), 0u) << m;
+      EXPECT_EQ(m.rfind("bad.toml:", 0), 0u) << m;
       EXPECT_NE(m.find(c.key), std::string::npos) << m;
     }
   }
+}
+
+// NaN and infinity are valid TOML; no numeric key may accept them.
+TEST(Fault, NonFiniteConfigValuesAreRefusedWithFileLineKey) {
+  expect_each_refused({
+      {"sensor", "fx", "inf"},          {"sensor", "cx", "nan"},
+      {"gripper", "joint_max_deg", "inf"}, {"stimulus", "fold_above_C", "nan"},
+      {"pso", "inertia", "nan"},        {"cost", "lambda_dice", "inf"},
+      {"cost", "lambda_kinematic", "-nan"}, {"render", "scale", "nan"},
+      {"observation", "prior_sigma_px", "inf"}, {"search", "position_min_mm", "[-inf, 0.0, 90.0]"},
+      {"tracker", "initial_pose", "[0, 0, nan, 0, 0, 0, 0, 0, 0, 0, 0, 0]"},
+      {"tracker", "default_stimulus", "nan"}, {"tracker", "fps", "inf"},
+      {"cost", "occlusion_growth_weight", "nan"},
+  });
+}
+
+// Finite values no real setup has (a principal point a million images
+// away, a turn of -900 degrees, a frame rate of 1e300) are refused as well.
+TEST(Fault, ImplausibleConfigValuesAreRefusedWithFileLineKey) {
+  expect_each_refused({
+      {"sensor", "cx", "1e9"},
+      {"sensor", "distortion", "[1e10, 1e10, 0, 0]"},
+      {"search", "rotation_min_deg", "[-900, -60, -180]"},
+      {"tracker", "fps", "1e300"},
+      {"tracker", "fps", "1e-300"},
+      {"tracker", "default_stimulus", "1e300"},
+      {"gripper", "folded_deg", "500"},
+      {"gripper", "unfolded_deg", "-10"},
+  });
 }
 
 // A NaN or infinity in --params never reaches the renderer.

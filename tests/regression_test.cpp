@@ -66,10 +66,21 @@ TEST(Regression, NonAsciiInCommentsAndStringsIsAccepted) {
 // value_at() computes v0 + a * (v1 - v0) and v1 - v0 overflows. An infinite
 // reading would reach the Stimulus plugin. Fixed in stimulus_log.cpp:
 // (1 - a) * v0 + a * v1, which stays finite for finite rows and a in [0, 1].
+// Since readings are bounded to a magnitude of 1e9, such a log is refused
+// at the row that leaves the bound, and readings at the bound interpolate.
 TEST(Regression, StimulusInterpolationStaysFinite) {
   const fs::path p = fs::path(GTRACK_TEST_SOURCE_DIR) / "fuzz" / "crashes" / "stimulus_interpolation_overflow.csv";
-  const auto log = gtrack::StimulusLog::load(p);
+  try {
+    gtrack::StimulusLog::load(p);
+    FAIL() << "a reading of -1e308 must be refused";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stimulus_interpolation_overflow.csv:2: expected a reading of magnitude up "
+                                         "to 1e9, got '-1e308'"),
+              std::string::npos)
+        << e.what();
+  }
+  const auto log = gtrack::StimulusLog::parse("frame,value\n0,-1e9\n2,1e9\n", "bound.csv");
   const auto v = log.value_at(1, 1 / 30.0);
   ASSERT_TRUE(v);
-  EXPECT_TRUE(std::isfinite(*v)) << *v;
+  EXPECT_DOUBLE_EQ(*v, 0.0);
 }

@@ -33,8 +33,9 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
   g.collision.max_difference_deg =
       t.number_or("max_adjacent_difference_deg", d.max_adjacent_difference_deg, Range::positive());
   g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", d.max_adjacent_sum_deg, Range::positive());
-  g.unfolded_deg = t.number_or("unfolded_deg", d.unfolded_deg);
-  g.folded_deg = t.number_or("folded_deg", d.folded_deg);
+  const Range limits = Range::closed(g.joint_min_deg, g.joint_max_deg);
+  g.unfolded_deg = t.number_or("unfolded_deg", d.unfolded_deg, limits);
+  g.folded_deg = t.number_or("folded_deg", d.folded_deg, limits);
   return g;
 }
 

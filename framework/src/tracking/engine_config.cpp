@@ -99,8 +99,13 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
   SearchConfig s;
   s.position_min_mm = vec3(t, "position_min_mm", nominal.array() - half);
   s.position_max_mm = vec3(t, "position_max_mm", nominal.array() + half);
-  s.rotation_min_deg = vec3(t, "rotation_min_deg", s.rotation_min_deg);
-  s.rotation_max_deg = vec3(t, "rotation_max_deg", s.rotation_max_deg);
+  // A bound past a full turn either way is no bound on an angle.
+  const auto angles = [&](const char* key, const Eigen::Vector3d& fallback) {
+    const auto v = t.numbers_or(key, {fallback.x(), fallback.y(), fallback.z()}, 3, Range::closed(-360, 360));
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  };
+  s.rotation_min_deg = angles("rotation_min_deg", s.rotation_min_deg);
+  s.rotation_max_deg = angles("rotation_max_deg", s.rotation_max_deg);
   for (int i = 0; i < 3; ++i) {
     if (!(s.position_min_mm[i] < s.position_max_mm[i])) t.fail("position_min_mm", "must be below position_max_mm");
     if (!(s.rotation_min_deg[i] < s.rotation_max_deg[i])) t.fail("rotation_min_deg", "must be below rotation_max_deg");
@@ -128,8 +133,11 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
     if (!space.contains(h)) t.fail("initial_pose", "lies outside the [search] bounds or the joint limits");
     c.initial_pose = h;
   }
-  c.fps = t.number_or("fps", c.fps, Range::non_negative());
-  if (t.has("default_stimulus")) c.default_stimulus = t.number("default_stimulus");
+  // 0: the source's own rate. Microscope and ultrasound cameras run from a
+  // frame a minute to a few hundred thousand a second.
+  c.fps = t.number_or("fps", c.fps, Range::closed(0, 1e6));
+  if (c.fps > 0 && c.fps < 1e-3) t.fail("fps", "expected 0 (the source's rate) or a rate of at least 0.001 frames/s");
+  if (t.has("default_stimulus")) c.default_stimulus = t.number("default_stimulus", Range::closed(-1e9, 1e9));
   c.lost_dice = t.number_or("lost_dice", c.lost_dice, {0.0, 1.0, true, false});
   c.reinit_after_lost = static_cast<int>(t.integer_or("reinit_after_lost", c.reinit_after_lost, Range::closed(1, 1e6)));
   c.coarse_rz_steps = static_cast<int>(t.integer_or("coarse_rz_steps", c.coarse_rz_steps, Range::closed(1, 360)));

@@ -120,6 +120,9 @@ void StimulusLog::take_line(std::string line) {
                      " in the first field, got " + quoted(a));
   }
   if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got " + quoted(b));
+  // No sensor of a lab reads past this in any unit; larger values are a
+  // unit or logging mistake, and overflow the interpolation.
+  if (std::abs(v) > 1e9) throw InputError(where + "expected a reading of magnitude up to 1e9, got " + quoted(b));
   if (!keys_.empty() && !(k > keys_.back())) {
     throw InputError(where + "expected " + key_name + " greater than the previous row's, got " + quoted(a));
   }

@@ -12,6 +12,7 @@
 //   (1-based; default: each finger with the next, around);
 //   max_adjacent_difference_deg, max_adjacent_sum_deg; symmetry_order;
 //   unfolded_deg, folded_deg.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <gtrack/error.hpp>
@@ -99,8 +100,10 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   // Default: what the geometry has already; a radial gripper is symmetric
   // under a turn by one finger, one drawn finger by finger is not.
   g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", g.symmetry_order, Range{1, 64}));
-  g.unfolded_deg = t.number_or("unfolded_deg", 0);
-  g.folded_deg = t.number_or("folded_deg", 60);
+  // Both are joint values the tracker starts from: within the limits.
+  const Range limits = Range::closed(g.joint_min_deg, g.joint_max_deg);
+  g.unfolded_deg = t.number_or("unfolded_deg", std::clamp(0.0, g.joint_min_deg, g.joint_max_deg), limits);
+  g.folded_deg = t.number_or("folded_deg", std::clamp(60.0, g.joint_min_deg, g.joint_max_deg), limits);
   return g;
 }
 

@@ -17,11 +17,13 @@ class PinholeMicroscope final : public gtrack::Sensor {
     fx_ = t.number("fx", Range::positive());
     fy_ = t.number_or("fy", fx_, Range::positive());
     // cx, cy as calibration tools give them (OpenCV: pixel centres on integers).
-    cx_ = t.number_or("cx", (width_ - 1) / 2.0);
-    cy_ = t.number_or("cy", (height_ - 1) / 2.0);
+    // A principal point far outside the image is a unit or typing mistake.
+    cx_ = t.number_or("cx", (width_ - 1) / 2.0, Range::closed(-10.0 * width_, 11.0 * width_));
+    cy_ = t.number_or("cy", (height_ - 1) / 2.0, Range::closed(-10.0 * height_, 11.0 * height_));
     near_ = t.number_or("near_mm", 1.0, Range::positive());
     working_distance_ = t.number_or("working_distance_mm", 100.0, Range::positive());
-    dist_ = t.numbers_or("distortion", {}, std::nullopt);
+    // Real lenses stay well inside +-1000, even in the rational model.
+    dist_ = t.numbers_or("distortion", {}, std::nullopt, Range::closed(-1000, 1000));
     if (!(dist_.empty() || dist_.size() == 4 || dist_.size() == 5 || dist_.size() == 8)) {
       t.fail("distortion", "expected 4, 5 or 8 coefficients (k1, k2, p1, p2[, k3[, k4, k5, k6]]), got " +
                                std::to_string(dist_.size()));
