@@ -6,6 +6,7 @@
 #include "command.hpp"
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/renderer.hpp"
 #include "gtrack/setup.hpp"
 
@@ -54,7 +55,20 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   auto renderer = gtrack::make_renderer(ro);
   renderer->set_model(model);
   renderer->set_projection(setup.sensor->projection(), ro.scale);
+  // Rendered as asked, but what the tracker would never consider is said.
+  const auto& g = model.geometry();
+  for (int f = 0; f < model.fingers(); ++f) {
+    const double q = h[gtrack::kPoseDims + f];
+    if (q < g.joint_min_deg || q > g.joint_max_deg) {
+      gtrack::logger().warn("q{} = {} is outside the gripper's joint limits [{}, {}]", f + 1, q, g.joint_min_deg,
+                            g.joint_max_deg);
+    }
+  }
   const cv::Mat mask = renderer->render_mask(h);
+  if (cv::countNonZero(mask) == 0) {
+    gtrack::logger().warn("the posed model covers no pixel of the image (outside the view, behind the camera or "
+                          "nearer than its near plane)");
+  }
   if (!cv::imwrite(out, mask)) throw gtrack::InputError(out + ": cannot write the image");
   std::cout << "mask " << mask.cols << "x" << mask.rows << " (" << cv::countNonZero(mask) << " pixels, "
             << renderer->name() << " backend) -> " << out << "\n";

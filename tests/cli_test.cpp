@@ -332,6 +332,14 @@ TEST(Cli, RenderChecksTheConfigAndItsOutputsFirst) {
   EXPECT_NE(r.output.find("' is not a folder"), std::string::npos) << r.output;
   r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + ok.parent_path().string());
   EXPECT_NE(r.output.find(": is a folder; expected a file name"), std::string::npos) << r.output;
+  // A pose the tracker would never consider is rendered, with a word each.
+  const std::string m = (fs::temp_directory_path() / "gtrack_cli_test" / "behind.png").string();
+  r = gtrack("render -c " + ok.string() + " -p 0,0,-100,0,0,0,999,0,0,0,0,0 -o " + m);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("q1 = 999 is outside the gripper's joint limits"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the posed model covers no pixel of the image"), std::string::npos) << r.output;
+  r = gtrack("render -c " + ok.string() + " -p 0,0,100,0,0,0,10,10,10,10,10,10 -o " + m);
+  EXPECT_EQ(r.output.find("[warning]"), std::string::npos) << r.output;
 }
 
 // A frame folder with a damaged image: the decoder's own words go into the
