@@ -57,6 +57,32 @@ TEST(Config, SyntaxErrorHasFileAndLine) {
   EXPECT_EQ(e.rfind("bad.toml:2:", 0), 0u) << e;
 }
 
+// A string left open says so, whichever quote it opened with and whether
+// the file ends there or the next line follows.
+TEST(Config, AnUnterminatedStringIsSaidToBeOne) {
+  for (const char* text : {"a = 1\nname = 'open\nb = 2\n", "a = 1\nname = \"open\nb = 2\n", "a = 1\nname = \"open"}) {
+    const std::string e = error_of([&] { gtrack::ConfigTable::parse(text, "s.toml"); });
+    EXPECT_EQ(e, "s.toml:2: unterminated string (expected its closing quote before the end of the line)") << text;
+  }
+  // Other string errors keep the parser's own words.
+  const std::string e = error_of([] { gtrack::ConfigTable::parse("name = \"a\x01b\"\n", "s.toml"); });
+  EXPECT_NE(e.find("control characters"), std::string::npos) << e;
+}
+
+// A huge key or value is quoted short; a plugin name must be one.
+TEST(Config, HugeTextIsQuotedShort) {
+  auto t = gtrack::ConfigTable::parse(std::string(100000, 'k') + " = 1\n", "h.toml");
+  std::string e = error_of([&] { t.check_all_used(); });
+  EXPECT_NE(e.find("h.toml:1: key '" + std::string(60, 'k') + "... (100000 characters)': unknown key"),
+            std::string::npos)
+      << e.substr(0, 300);
+  EXPECT_LT(e.size(), 300u);
+  auto p = gtrack::ConfigTable::parse("[sensor]\nplugin = \"" + std::string(100000, 'A') + "\"\n", "h.toml");
+  e = error_of([&] { gtrack::testing::loader().make_sensor(p.table("sensor")); });
+  EXPECT_EQ(e, "h.toml:2: key 'sensor.plugin': expected a plugin name (letters, digits, '_' and '-', 1 to 64 "
+               "characters), got a string of 100000 characters");
+}
+
 TEST(Config, UnknownTableAtTopLevel) {
   auto t = gtrack::ConfigTable::parse("[sensr]\nx = 1\n[sensor]\ny = 2\n", "t.toml");
   t.table("sensor");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -24,6 +25,24 @@ struct ConfigTable::Impl {
 };
 
 namespace {
+
+// Text from a config as it is quoted in a message: at most 60 characters,
+// control bytes as \xNN (a 1 MB value must not become a 1 MB error line).
+std::string shown(std::string_view text) {
+  std::string out;
+  for (size_t i = 0; i < text.size() && i < 60; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  if (text.size() > 60) out += "... (" + std::to_string(text.size()) + " characters)";
+  return out;
+}
 
 std::string describe_range(const Range& r) {
   std::ostringstream s;
@@ -119,6 +138,25 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
         d.find("could not determine value type") != std::string_view::npos) {
       s << " (a text value needs quotes: key = \"text\")";
     }
+    // A string that reaches the end of its line (or of the file) without
+    // its closing quote: said so, instead of the parser's complaint about
+    // the line break it met.
+    if (d.find("string") != std::string_view::npos) {
+      size_t at = 0;
+      for (auto line = e.source().begin.line; line > 1 && at != std::string_view::npos; --line) {
+        at = text.find('\n', at);
+        if (at != std::string_view::npos) ++at;
+      }
+      const size_t col = e.source().begin.column > 0 ? e.source().begin.column - 1 : 0;
+      if (at != std::string_view::npos) {
+        const size_t end = std::min(text.find('\n', at), text.size());
+        if (at + col >= end || text[at + col] == '\r' || text[at + col] == '\n') {
+          s.str("");
+          s << source << ":" << e.source().begin.line << ": unterminated string (expected its closing quote before "
+            << "the end of the line)";
+        }
+      }
+    }
     throw ConfigError(s.str());
   }
   impl->table = impl->root.get();
@@ -151,7 +189,7 @@ std::string ConfigTable::where(std::string_view key) const {
   if (line > 0) s << ":" << line;
   s << ": ";
   std::string full = impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key);
-  s << "key '" << full << "'";
+  s << "key '" << shown(full) << "'";
   return s.str();
 }
 
@@ -261,7 +299,7 @@ std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
   if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
-    std::string msg = "unknown value \"" + v + "\"; expected one of " + list;
+    std::string msg = "unknown value \"" + shown(v) + "\"; expected one of " + list;
     if (auto m = closest_match(v, allowed)) msg += " (did you mean \"" + *m + "\"?)";
     fail(key, msg);
   }

@@ -278,6 +278,15 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
                              table.misspelling_hint("plugin"));
   }
   const std::string name = table.string("plugin");
+  // A plugin name is part of a file name: libgtrack_<name>.so.
+  const bool valid = !name.empty() && name.size() <= 64 &&
+                     std::all_of(name.begin(), name.end(), [](char c) {
+                       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+                     });
+  if (!valid) {
+    table.fail("plugin", "expected a plugin name (letters, digits, '_' and '-', 1 to 64 characters), got a string of " +
+                             std::to_string(name.size()) + " characters");
+  }
   fs::path file;
   try {
     file = find(kind, name);
