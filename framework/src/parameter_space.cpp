@@ -35,8 +35,7 @@ ParameterSpace ParameterSpace::make(int fingers, const Eigen::Vector3d& pos_lo, 
                                     double joint_hi, bool rz_periodic) {
   ParameterSpace s;
   const int d = kPoseDims + fingers;
-  s.names = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
-  for (int f = 0; f < fingers; ++f) s.names.push_back(joint_name(f + 1));
+  for (int i = 0; i < d; ++i) s.names.push_back(parameter_name(i));
   s.lower.resize(d);
   s.upper.resize(d);
   s.lower << pos_lo, rot_lo, Eigen::VectorXd::Constant(fingers, joint_lo);
@@ -77,5 +76,10 @@ Eigen::VectorXd parse_parameter_vector(std::string_view text, int expected_dims)
 }
 
 std::string joint_name(int finger) { return "q" + std::to_string(finger) + "_deg"; }
+
+std::string parameter_name(int d) {
+  static const char* const pose[kPoseDims] = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
+  return d < kPoseDims ? pose[d] : joint_name(d - kPoseDims + 1);
+}
 
 }  // namespace gtrack

@@ -20,6 +20,9 @@ inline constexpr int kPoseDims = 6;  // x, y, z, rx, ry, rz
 // "q<finger>_deg", the name of finger `finger`'s joint (from 1) in every
 // table gtrack reads and writes.
 GTRACK_API std::string joint_name(int finger);
+// The name of parameter d of a configuration in those tables: "x_mm",
+// "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg", then joint_name(d - 5).
+GTRACK_API std::string parameter_name(int d);
 
 struct ParameterSpace {
   std::vector<std::string> names;  // "x_mm", ..., "rz_deg", "q1_deg", ...

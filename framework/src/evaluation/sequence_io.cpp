@@ -56,7 +56,8 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
   for (int i = 0; i < static_cast<int>(header.size()); ++i) col[header[i]] = i;
 
   PoseTable table;
-  std::vector<std::string> names = {"frame", "x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
+  std::vector<std::string> names = {"frame"};
+  for (int d = 0; d < kPoseDims; ++d) names.push_back(parameter_name(d));
   for (const auto& n : names) {
     if (!col.count(n)) throw InputError(file.string() + ":1: missing column '" + n + "'");
   }
@@ -143,8 +144,8 @@ PoseTable read_pose_table(const std::filesystem::path& file) { return read_table
 PoseTable read_truth_table(const std::filesystem::path& file) { return read_table(file, true); }
 
 std::string pose_table_header(int fingers, const std::vector<std::string>& extra) {
-  std::string s = "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg";
-  for (int f = 0; f < fingers; ++f) s += ",q" + std::to_string(f + 1) + "_deg";
+  std::string s = "frame";
+  for (int d = 0; d < kPoseDims + fingers; ++d) s += "," + parameter_name(d);
   for (const auto& e : extra) s += "," + e;
   return s;
 }

@@ -118,11 +118,9 @@ void ResultWriter::sync() {
 
 std::string estimate_json(const Estimate& e) {
   const Eigen::VectorXd& h = e.hypothesis;
-  static const char* pose[] = {"x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"};
   std::string j = "{\"frame\":" + std::to_string(e.frame) + ",\"time_s\":" + num(e.time_s, "%.6f");
   for (Eigen::Index i = 0; i < h.size(); ++i) {
-    const std::string name = i < kPoseDims ? pose[i] : joint_name(i - kPoseDims + 1);
-    j += ",\"" + name + "\":" + num(h[i], i < 3 ? "%.6f" : "%.4f");
+    j += ",\"" + parameter_name(static_cast<int>(i)) + "\":" + num(h[i], i < 3 ? "%.6f" : "%.4f");
   }
   j += ",\"cost\":" + num(e.terms.total, "%.6f") + ",\"status\":\"" + to_string(e.status) + "\",\"ms\":" +
        num(e.ms, "%.3f");
