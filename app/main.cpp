@@ -47,22 +47,6 @@ void print_usage(std::ostream& os) {
   os << "\n" << common_options();
 }
 
-// An error line as the terminal should show it: control bytes (from a
-// binary file quoted in a message) as \xNN, so the line stays one line.
-std::string printable(const std::string& text) {
-  std::string out;
-  for (const unsigned char c : text) {
-    if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out;
-}
-
 // The common options that take a value may also come before the command
 // (`gtrack --log-level debug plugins`): they are moved after it.
 std::vector<char*> command_first(int argc, char** argv) {
@@ -118,7 +102,7 @@ int run(int argc, char** argv) {
   if (!cmd) {
     std::vector<std::string> names;
     for (const auto& c : registry()) names.push_back(c.name);
-    std::string msg = "gtrack: error: unknown command '" + printable(first) + "'";
+    std::string msg = "gtrack: error: unknown command '" + gtrack::shown(first) + "'";
     if (auto m = gtrack::closest_match(first, names)) msg += " (did you mean '" + *m + "'?)";
     std::cerr << msg << "; run 'gtrack --help' for the list\n";
     return 2;
@@ -143,7 +127,7 @@ int run(int argc, char** argv) {
     }
     po::notify(vm);
   } catch (const po::error& e) {
-    std::cerr << "gtrack: error: " << printable(e.what()) << " (see 'gtrack " << cmd->name << " --help')\n";
+    std::cerr << "gtrack: error: " << gtrack::shown(e.what()) << " (see 'gtrack " << cmd->name << " --help')\n";
     return 2;
   }
 
@@ -163,13 +147,13 @@ int main(int argc, char** argv) {
     std::vector<char*> args = command_first(argc, argv);
     return run(static_cast<int>(args.size()), args.data());
   } catch (const gtrack::cli::UsageError& e) {
-    std::cerr << "gtrack: error: " << printable(e.what()) << "\n";
+    std::cerr << "gtrack: error: " << gtrack::shown(e.what()) << "\n";
     return 2;
   } catch (const gtrack::Error& e) {
-    std::cerr << "gtrack: error: " << printable(e.what()) << "\n";
+    std::cerr << "gtrack: error: " << gtrack::shown(e.what()) << "\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "gtrack: error: " << printable(e.what()) << "\n";
+    std::cerr << "gtrack: error: " << gtrack::shown(e.what()) << "\n";
     return 1;
   }
 }

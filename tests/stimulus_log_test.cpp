@@ -47,7 +47,7 @@ TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
             "'99999999999999999999999'");
   // Long or binary fields are quoted short and printable.
   EXPECT_EQ(error_of("frame,value\n0," + std::string(100, 'A') + "\n"),
-            "log.csv:2: expected a number in the value field, got '" + std::string(60, 'A') + "...' (100 characters)");
+            "log.csv:2: expected a number in the value field, got '" + std::string(60, 'A') + "... (100 characters)'");
   EXPECT_EQ(error_of(std::string("frame,value\n0,\x01\xff\n")),
             "log.csv:2: expected a number in the value field, got '\\x01\\xFF'");
   EXPECT_EQ(error_of("frame,value\n3,20\n2,21\n"),

@@ -26,24 +26,6 @@ struct ConfigTable::Impl {
 
 namespace {
 
-// Text from a config as it is quoted in a message: at most 60 characters,
-// control bytes as \xNN (a 1 MB value must not become a 1 MB error line).
-std::string shown(std::string_view text) {
-  std::string out;
-  for (size_t i = 0; i < text.size() && i < 60; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02X", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  if (text.size() > 60) out += "... (" + std::to_string(text.size()) + " characters)";
-  return out;
-}
-
 std::string describe_range(const Range& r) {
   std::ostringstream s;
   if (r.min && r.max) {
@@ -189,7 +171,7 @@ std::string ConfigTable::where(std::string_view key) const {
   if (line > 0) s << ":" << line;
   s << ": ";
   std::string full = impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key);
-  s << "key '" << shown(full) << "'";
+  s << "key '" << shown(full, 60) << "'";
   return s.str();
 }
 
@@ -299,7 +281,7 @@ std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
   if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + ("\"" + a + "\"");
-    std::string msg = "unknown value \"" + shown(v) + "\"; expected one of " + list;
+    std::string msg = "unknown value \"" + shown(v, 60) + "\"; expected one of " + list;
     if (auto m = closest_match(v, allowed)) msg += " (did you mean \"" + *m + "\"?)";
     fail(key, msg);
   }

@@ -6,8 +6,10 @@
 // stack trace or aborts on bad input.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "gtrack/export.hpp"
 
@@ -35,5 +37,11 @@ class GTRACK_API InputError : public Error {
  public:
   using Error::Error;
 };
+
+// Text from an input as a message quotes it, so that the message stays one
+// short line: control bytes (and, with `ascii`, every byte outside printable
+// ASCII) as \xNN, and at most `max` bytes of it, followed by
+// "... (N characters)" when cut.
+GTRACK_API std::string shown(std::string_view text, std::size_t max = std::string_view::npos, bool ascii = false);
 
 }  // namespace gtrack

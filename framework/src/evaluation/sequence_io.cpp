@@ -88,13 +88,15 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
     PoseRow row;
     double v = 0;
     if (!parse_number(cells[idx[0]], v) || v != std::floor(v) || v < 0 || v > 2147483647.0) {
-      throw InputError(where + "expected a frame index (a whole number from 0), got '" + cells[idx[0]] + "'");
+      throw InputError(where + "expected a frame index (a whole number from 0), got '" + shown(cells[idx[0]], 60) +
+                       "'");
     }
     row.frame = static_cast<int>(v);
     row.h.resize(kPoseDims + table.fingers);
     for (int d = 0; d < row.h.size(); ++d) {
       if (!parse_number(cells[idx[d + 1]], row.h[d])) {
-        throw InputError(where + "expected a number for '" + names[d + 1] + "', got '" + cells[idx[d + 1]] + "'");
+        throw InputError(where + "expected a number for '" + names[d + 1] + "', got '" +
+                         shown(cells[idx[d + 1]], 60) + "'");
       }
       if (finite && !std::isfinite(row.h[d])) {
         throw InputError(where + "expected a finite number for '" + names[d + 1] + "' in a ground truth (frame " +
@@ -103,7 +105,7 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
       // A kilometre or a thousand turns is no pose of a micro-gripper, and
       // larger values overflow the error figures.
       if (std::abs(row.h[d]) > kMaxPoseCell) {
-        throw InputError(where + "'" + names[d + 1] + "' = " + cells[idx[d + 1]].substr(0, 32) +
+        throw InputError(where + "'" + names[d + 1] + "' = " + shown(cells[idx[d + 1]], 32) +
                          " is not a plausible pose value (expected a magnitude up to 1e6 " +
                          (d < 3 ? "mm" : "deg") + ")");
       }
@@ -111,7 +113,7 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
     if (status_col >= 0) {
       row.status = cells[status_col];
       if (row.status != "ok" && row.status != "search" && row.status != "lost") {
-        throw InputError(where + "expected a status of ok, search or lost, got '" + row.status + "'");
+        throw InputError(where + "expected a status of ok, search or lost, got '" + shown(row.status, 60) + "'");
       }
       // Only a lost frame has no configuration.
       if (row.status != "lost" && !row.h.allFinite()) {
@@ -125,7 +127,8 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
       const std::string& cell = cells[extra_idx[e]];
       if (cell.empty()) continue;
       if (!parse_number(cell, v)) {
-        throw InputError(where + "expected a number for '" + table.extra_columns[e] + "', got '" + cell + "'");
+        throw InputError(where + "expected a number for '" + table.extra_columns[e] + "', got '" + shown(cell, 60) +
+                         "'");
       }
       row.extra[table.extra_columns[e]] = v;
     }

@@ -245,9 +245,9 @@ std::vector<int> resume_results(const fs::path& out_dir, int fingers, int last) 
     for (size_t i = first; i < lines.size(); ++i) {
       const int f = row_frame(lines[i], prefix);
       if (f < 0) {
+        const std::string expected = prefix.empty() ? "a frame index" : "'" + prefix + "' and a frame index";
         throw InputError(file.string() + ":" + std::to_string(i + 1) + ": expected a row that starts with " +
-                         (prefix.empty() ? std::string("a frame index") : "'" + prefix + "' and a frame index") + ", got '" + lines[i].substr(0, 40) + (lines[i].size() > 40 ? "...'" : "'") +
-                         "; cannot resume");
+                         expected + ", got '" + shown(lines[i], 40) + "'; cannot resume");
       }
       if (f > last) break;
       kept.push_back(lines[i]);

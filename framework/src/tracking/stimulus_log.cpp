@@ -28,23 +28,8 @@ bool parse_number(const std::string& text, double& out) {
   return ec == std::errc() && end == t.data() + t.size() && std::isfinite(out);
 }
 
-// A field as it is quoted in a message: at most 60 characters, bytes that
-// are not printable ASCII as \xNN.
-std::string quoted(const std::string& text) {
-  std::string q = "'";
-  for (size_t i = 0; i < text.size() && i < 60; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      q += static_cast<char>(c);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02X", c);
-      q += buf;
-    }
-  }
-  q += text.size() > 60 ? "...' (" + std::to_string(text.size()) + " characters)" : "'";
-  return q;
-}
+// A field as it is quoted in a message: short, printable ASCII.
+std::string quoted(const std::string& text) { return "'" + shown(text, 60, true) + "'"; }
 
 // A row of a stimulus log is a few dozen characters.
 constexpr size_t kMaxLine = 4096;
