@@ -127,8 +127,10 @@ class VideoSource final : public FrameSource {
       throw InputError(name_ + ": no frame could be decoded (corrupt or unsupported video" +
                        (said.empty() ? std::string(")") : "; the decoder said: " + said + ")"));
     }
-    if (!live_ && count_ > 0 && index_ < count_ && ended_early_.empty()) {
-      const std::string why = !said.empty() ? said : last_said_;
+    // A container's count can be an estimate (duration times rate): one
+    // frame short with no word from the decoder is taken as that.
+    const std::string why = !said.empty() ? said : last_said_;
+    if (!live_ && count_ > 0 && index_ < count_ - (why.empty() ? 1 : 0) && ended_early_.empty()) {
       ended_early_ = "decoding stopped at frame " + std::to_string(index_) + " of the " + std::to_string(count_) +
                      " the video declares" + (why.empty() ? std::string() : " (the decoder said: " + why + ")");
       logger().warn("{}: {}; the frames before it are tracked", name_, ended_early_);
