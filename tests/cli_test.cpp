@@ -423,6 +423,18 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_NE(r.output.find("header_only.csv: a header and no rows"), std::string::npos) << r.output;
   r = eval(dir / "no_such.csv", truth);
   EXPECT_NE(r.output.find("no_such.csv: no such file"), std::string::npos) << r.output;
+  // A column named twice is refused, not read from one of the two.
+  r = eval(truth, table("dup.csv", {rows[0] + ",x_mm", rows[1] + ",7", rows[2] + ",7"}));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("dup.csv:1: column 'x_mm' appears twice (columns 2 and 17)"), std::string::npos)
+      << r.output;
+  // The tracker's estimates given as the truth: said, not scored.
+  ASSERT_EQ(gtrack(track_of(dir) + " --no-overlay -o " + (dir / "tracked").string()).code, 0);
+  r = eval(dir / "tracked" / "estimates.csv", truth);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("estimates.csv:1: has the tracker's 'status' column; expected a ground truth"),
+            std::string::npos)
+      << r.output;
 }
 
 // eval --breakdown: every in-view frame with an estimate falls in exactly

@@ -680,6 +680,13 @@ TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
   std::ofstream(csv) << csv_text.substr(0, second) << "garbage,row,here\n" << csv_text.substr(csv_text.find('\n', second) + 1);
   expect_refusal_naming(track_error(r, again), "estimates.csv:3: expected a row that starts with a frame index, got 'garbage,row,here'");
   std::ofstream(csv) << csv_text;
+  // Estimates whose tracker state is gone are refused, not started over.
+  const fs::path state = o.out_dir / "tracker_state.txt";
+  const std::string state_text = read_text(state);
+  fs::remove(state);
+  expect_refusal_naming(track_error(r, again), "estimates.csv: holds tracked frames but tracker_state.txt is missing");
+  EXPECT_EQ(read_text(csv), csv_text);
+  std::ofstream(state) << state_text;
   EXPECT_EQ(track_error(r, again), "");
   EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_EQ(read_lines(jsonl).size(), 8u);

@@ -53,7 +53,18 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
   if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
   const auto header = split_csv(line);
   std::map<std::string, int> col;
-  for (int i = 0; i < static_cast<int>(header.size()); ++i) col[header[i]] = i;
+  for (int i = 0; i < static_cast<int>(header.size()); ++i) {
+    if (!col.emplace(header[i], i).second) {
+      throw InputError(file.string() + ":1: column '" + shown(header[i], 60) + "' appears twice (columns " +
+                       std::to_string(col[header[i]] + 1) + " and " + std::to_string(i + 1) + ")");
+    }
+  }
+  // A tracker's output read as the truth (the two files given the other way round).
+  if (finite && col.count("status")) {
+    throw InputError(file.string() +
+                     ":1: has the tracker's 'status' column; expected a ground truth (are the truth and the "
+                     "estimates given the other way round?)");
+  }
 
   PoseTable table;
   std::vector<std::string> names = {"frame"};

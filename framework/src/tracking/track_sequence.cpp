@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <opencv2/core.hpp>
@@ -190,6 +191,18 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
+    // Estimates without the state they end with cannot be continued, and
+    // starting over would replace them.
+    const fs::path estimates = options.out_dir / "estimates.csv";
+    std::ifstream in(estimates);
+    std::string line;
+    int rows = 0;
+    while (rows < 2 && std::getline(in, line)) rows += line.empty() ? 0 : 1;
+    if (rows > 1) {
+      throw InputError(estimates.string() + ": holds tracked frames but " + state_file.filename().string() +
+                       " is missing; cannot resume (a new run would replace them: choose another --out, or run "
+                       "without --resume)");
+    }
     logger().info("{}: no tracker state to resume from; starting from the first frame", state_file.string());
   }
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
