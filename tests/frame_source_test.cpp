@@ -33,10 +33,11 @@ std::vector<std::string> names(gtrack::FrameSource& src) {
 }
 
 // Lab recordings number their frames without padding: frame9 comes before
-// frame10, as a person reads them, not as the bytes sort.
+// frame10, as a person reads them, not as the bytes sort. Hidden files (a
+// copy's "._" metadata, an image being written) are not frames.
 TEST(FrameSource, AFolderIsReadInTheOrderOfTheNumbersInItsNames) {
   const fs::path dir = folder_of("natural", {"frame10.png", "frame9.png", "frame1.png", "frame100.png", "frame09.png",
-                                             "other.png", "frame2.png"});
+                                             "other.png", "frame2.png", "._frame3.png", ".frame4.png"});
   auto src = gtrack::open_frame_source(dir.string(), {4, 4}, {}, 30);
   EXPECT_EQ(names(*src), (std::vector<std::string>{"frame1.png@0", "frame2.png@1", "frame09.png@2", "frame9.png@3",
                                                    "frame10.png@4", "frame100.png@5", "other.png@6"}));

@@ -227,6 +227,9 @@ class FolderSource final : public FrameSource {
     for (fs::directory_iterator it(dir_, ec), end; !ec && it != end; it.increment(ec)) {
       std::error_code entry_ec;  // an entry that vanished or dangles is skipped
       if (!it->is_regular_file(entry_ec)) continue;
+      // Hidden files are no frames: a copy's metadata (macOS "._name.png")
+      // or an image still being written under a temporary name.
+      if (it->path().filename().string().front() == '.') continue;
       std::string ext = it->path().extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
       if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(it->path());
