@@ -687,6 +687,12 @@ TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
   expect_refusal_naming(track_error(r, again), "estimates.csv: holds tracked frames but tracker_state.txt is missing");
   EXPECT_EQ(read_text(csv), csv_text);
   std::ofstream(state) << state_text;
+  // Another stride (or input, or stimulus log) would join two runs' frames.
+  gtrack::TrackOptions other = again;
+  other.range.every = 2;
+  expect_refusal_naming(track_error(r, other), "tracker_state.txt: the interrupted run tracked input=");
+  EXPECT_NE(track_error(r, other).find("every=1 stimulus=none; this one input="), std::string::npos);
+  EXPECT_EQ(read_text(csv), csv_text);
   EXPECT_EQ(track_error(r, again), "");
   EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_EQ(read_lines(jsonl).size(), 8u);

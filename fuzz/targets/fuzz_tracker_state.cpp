@@ -45,7 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   back << in.rdbuf();
   const gtrack::TrackerState t = gtrack::parse_tracker_state(back.str(), file.string());
   if (t.frame != s.frame || t.lost != s.lost || t.started != s.started || t.reference_area != s.reference_area ||
-      !same(t.last, s.last) || !same(t.before_last, s.before_last)) {
+      !same(t.last, s.last) || !same(t.before_last, s.before_last) || t.run != s.run) {
     __builtin_trap();
   }
   return 0;

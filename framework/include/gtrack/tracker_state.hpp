@@ -10,6 +10,7 @@
 //   before_last -
 //   last_found 0
 //   found_step -
+//   run input=/data/rec1/frames every=1 stimulus=/data/rec1/stimulus.csv
 //
 // The configurations are written with 17 significant digits, so a resumed
 // run starts from exactly the values the interrupted one held.
@@ -38,6 +39,11 @@ struct TrackerState {
   int lost = 0;
   bool started = false;
   std::uint64_t reference_area = 0;
+  // What the run tracks (its input, stride and stimulus log), written by
+  // track_sequence() so that --resume refuses to join another recording's
+  // frames; the tracker itself neither sets nor reads it. Empty in states of
+  // earlier releases.
+  std::string run;
 };
 
 // Replaces `file` (write, then rename): never a half-written state.

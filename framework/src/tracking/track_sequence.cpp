@@ -186,8 +186,23 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   if (options.resume && options.input.rfind("camera:", 0) == 0) {
     throw InputError("--resume continues a video or a folder of images, not a live camera (" + options.input + ")");
   }
+  // What this run tracks, kept in its state: a resumed run must go on
+  // with the same frames and readings.
+  const auto absolute = [](const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+    return ec ? path : p.string();
+  };
+  const std::string run = "input=" + (options.input.rfind("camera:", 0) == 0 ? options.input : absolute(options.input)) +
+                          " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
+                          (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none"));
   if (options.resume && fs::exists(state_file)) {
     resumed = read_tracker_state(state_file);
+    if (!resumed->run.empty() && resumed->run != run) {
+      throw InputError(state_file.string() + ": the interrupted run tracked " + shown(resumed->run, 300) +
+                       "; this one " + shown(run, 300) +
+                       "; cannot resume (give the same --input, --every and --stimulus, or another --out)");
+    }
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
@@ -330,7 +345,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     e.times.io_ms = io_ms;
     results.write(e);
     if (options.durable) results.sync();  // the rows before the state that says they are done
-    write_tracker_state(state_file, tracker.state(), options.durable);
+    TrackerState state = tracker.state();
+    state.run = run;
+    write_tracker_state(state_file, state, options.durable);
     if (options.on_frame) options.on_frame(e);
 
     ++summary.frames;

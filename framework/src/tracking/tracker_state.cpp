@@ -48,6 +48,10 @@ void write_tracker_state(const fs::path& file, const TrackerState& s, bool durab
   write_vector(out, "before_last", s.before_last);
   out << "last_found " << (s.last_found ? 1 : 0) << "\n";
   write_vector(out, "found_step", s.found_step);
+  if (!s.run.empty()) {
+    if (s.run.find('\n') != std::string::npos) throw InputError("a tracker state's run line cannot hold a line break");
+    out << "run " << s.run << "\n";
+  }
   detail::replace_file(file, out.str(), durable);
 }
 
@@ -73,6 +77,11 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
         fail("expected 'gtrack-tracker-state 1', the header of a tracker state");
       }
       header = true;
+      continue;
+    }
+    if (key == "run") {
+      s.run = line.size() > 4 ? line.substr(4) : std::string();
+      if (line.size() < 4 || line[3] != ' ' || s.run.empty()) fail("expected the run's input after 'run '");
       continue;
     }
     if (key == "last" || key == "before_last" || key == "found_step") {
