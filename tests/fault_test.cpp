@@ -300,7 +300,13 @@ TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {
   o.progress = false;
   std::vector<std::optional<double>> readings;
   o.on_frame = [&](const gtrack::Estimate& e) { readings.push_back(e.stimulus); };
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
   const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  gtrack::logger().sinks().pop_back();
+  const std::string said = "stimulus.csv: frame 3 (t = 0.100 s) is outside the stimulus log, whose rows cover frames 0 to 2";
+  EXPECT_NE(log.str().find(said), std::string::npos) << log.str();
+  EXPECT_EQ(log.str().find("is outside the stimulus log"), log.str().rfind("is outside the stimulus log")) << log.str();
   EXPECT_EQ(s.frames, kFrames);
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), static_cast<size_t>(kFrames));
   ASSERT_EQ(readings.size(), static_cast<size_t>(kFrames));

@@ -41,6 +41,9 @@ class GTRACK_API StimulusLog {
   // must have a row.
   double nearest(int frame, double time_s) const;
   size_t rows() const { return keys_.size(); }
+  // The first and last rows' keys (frame index or time_s); rows() > 0.
+  double first_key() const { return keys_.front(); }
+  double last_key() const { return keys_.back(); }
   const std::string& source() const { return source_; }
 
  private:

@@ -241,8 +241,14 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     std::optional<double> reading = log->value_at(index, time_s);
     if (!reading) {
       if (!warned_range) {
-        logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log; holding its nearest reading",
-                      log->source(), index, time_s);
+        // The log's span is said: a log keyed by another clock (seconds
+        // since 1970, say) shows at once.
+        const bool by_time = log->key() == StimulusLog::Key::Time;
+        logger().warn(
+            "{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.9g} to {:.9g}; "
+            "holding its nearest reading",
+            log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(),
+            log->last_key());
         warned_range = true;
       }
       reading = log->nearest(index, time_s);
