@@ -620,14 +620,22 @@ TEST(Fault, DurableRunWritesTheSameRowsAndState) {
   EXPECT_FALSE(fs::exists(dir / "durable" / "tracker_state.txt.tmp"));
 }
 
+// A run of frames 0-2 of kFrames, stopped there, to be resumed.
+struct StoppedRun {
+  TrackRun run;
+  gtrack::TrackOptions options;
+};
+StoppedRun stopped_run(const std::string& name) {
+  StoppedRun s{make_run(), folder_run(fresh_dir(name), kFrames)};
+  s.options.range.last = 3;
+  gtrack::track_sequence(s.run.setup, s.run.config, s.options);
+  return s;
+}
+
 // A damaged state file, or rows that stop before the state's frame: one
 // line naming the file, and the files are left as they were.
 TEST(Fault, ResumeRefusesADamagedStateWithFileAndLine) {
-  const fs::path dir = fresh_dir("resume_bad");
-  const TrackRun r = make_run();
-  gtrack::TrackOptions o = folder_run(dir, kFrames);
-  o.range.last = 3;
-  gtrack::track_sequence(r.setup, r.config, o);
+  const auto [r, o] = stopped_run("resume_bad");
   const fs::path state = o.out_dir / "tracker_state.txt";
   std::string text = read_text(state);
   const auto expect_refusal = [&](const std::string& what) {
@@ -664,11 +672,7 @@ TEST(Fault, ResumeRefusesADamagedStateWithFileAndLine) {
 // one cut short, or a row that is no row, is refused by file and line, and
 // neither file is changed.
 TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
-  const fs::path dir = fresh_dir("resume_rows");
-  const TrackRun r = make_run();
-  gtrack::TrackOptions o = folder_run(dir, kFrames);
-  o.range.last = 3;
-  gtrack::track_sequence(r.setup, r.config, o);
+  const auto [r, o] = stopped_run("resume_rows");
   const fs::path csv = o.out_dir / "estimates.csv", jsonl = o.out_dir / "estimates.jsonl";
   const std::string csv_text = read_text(csv), jsonl_text = read_text(jsonl);
   gtrack::TrackOptions again = o;
