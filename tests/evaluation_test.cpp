@@ -208,6 +208,17 @@ TEST(Evaluation, AnOverflowingErrorIsNotReportedAsZero) {
   EXPECT_FALSE(e.endpoint_um < 1e9) << e.endpoint_um;
 }
 
+// The message with which a table of `text` is refused ("" if it is read).
+std::string refusal(const std::filesystem::path& file, const std::string& text, bool truth = false) {
+  std::ofstream(file) << text;
+  try {
+    truth ? gtrack::read_truth_table(file) : gtrack::read_pose_table(file);
+  } catch (const gtrack::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
   const auto dir = std::filesystem::temp_directory_path() / "gtrack_eval_test";
   std::filesystem::create_directories(dir);
@@ -223,64 +234,29 @@ TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
   EXPECT_EQ(t.rows[1].status, "lost");
   EXPECT_DOUBLE_EQ(t.rows[0].h[7], 8);
   EXPECT_DOUBLE_EQ(t.rows[0].extra.at("cost"), 0.1);
-  {
-    std::ofstream f(dir / "bad.csv");
-    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg\n0,1,2,3,4,5,6,7\n1,1,two,3,4,5,6,7\n";
-  }
-  try {
-    gtrack::read_pose_table(dir / "bad.csv");
-    FAIL() << "a malformed row must throw";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.csv:3"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("y_mm"), std::string::npos) << e.what();
-  }
+  const std::string header = "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg";
+  const std::string bad = refusal(dir / "bad.csv", header + "\n0,1,2,3,4,5,6,7\n1,1,two,3,4,5,6,7\n");
+  EXPECT_NE(bad.find("bad.csv:3"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("y_mm"), std::string::npos) << bad;
   // An estimate may be lost (null); a ground truth may not, or every mean
   // over it would come out NaN.
-  {
-    std::ofstream f(dir / "truth.csv");
-    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg\n0,1,2,3,4,5,6,7\n1,1,2,3,4,5,6,7\n2,1,2,3,4,5,6,nan\n";
-  }
+  const std::string truth_text = header + "\n0,1,2,3,4,5,6,7\n1,1,2,3,4,5,6,7\n2,1,2,3,4,5,6,nan\n";
+  EXPECT_EQ(refusal(dir / "truth.csv", truth_text), "");
   EXPECT_EQ(gtrack::read_pose_table(dir / "truth.csv").rows.size(), 3u);
-  try {
-    gtrack::read_truth_table(dir / "truth.csv");
-    FAIL() << "a truth with NaN must throw";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("truth.csv:4: expected a finite number for 'q1_deg'"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_NE(refusal(dir / "truth.csv", truth_text, true).find("truth.csv:4: expected a finite number for 'q1_deg'"),
+            std::string::npos);
   // A byte-order mark before the header is skipped; a row that says it is
   // tracked but has no configuration is refused (only a lost one may).
-  {
-    std::ofstream f(dir / "bom.csv");
-    f << "\xEF\xBB\xBF" "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,status\n0,1,2,3,4,5,6,7,ok\n"
-         "1,nan,nan,nan,nan,nan,nan,nan,lost\n";
-  }
+  EXPECT_EQ(refusal(dir / "bom.csv", "\xEF\xBB\xBF" + header + ",status\n0,1,2,3,4,5,6,7,ok\n1,nan,nan,nan,nan,nan,nan,nan,lost\n"),
+            "");
   EXPECT_EQ(gtrack::read_pose_table(dir / "bom.csv").rows.size(), 2u);
-  {
-    std::ofstream f(dir / "nan_ok.csv");
-    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,status\n0,1,2,3,4,5,6,7,ok\n1,1,2,nan,4,5,6,7,ok\n";
-  }
-  try {
-    gtrack::read_pose_table(dir / "nan_ok.csv");
-    FAIL() << "a NaN in a row with status ok must throw";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("nan_ok.csv:3: expected a finite number for 'z_mm' in a row whose status is ok"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string nan_ok = refusal(dir / "nan_ok.csv", header + ",status\n0,1,2,3,4,5,6,7,ok\n1,1,2,nan,4,5,6,7,ok\n");
+  EXPECT_NE(nan_ok.find("nan_ok.csv:3: expected a finite number for 'z_mm' in a row whose status is ok"),
+            std::string::npos)
+      << nan_ok;
   // A value no micro-gripper pose can have is refused by name and line.
-  {
-    std::ofstream f(dir / "far.csv");
-    f << "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg\n0,1,2,3,4,5,6,7\n1,1e200,2,3,4,5,6,7\n";
-  }
-  try {
-    gtrack::read_pose_table(dir / "far.csv");
-    FAIL() << "a position of 1e200 mm must throw";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("far.csv:3: 'x_mm' = 1e200 is not a plausible pose value"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string far = refusal(dir / "far.csv", header + "\n0,1,2,3,4,5,6,7\n1,1e200,2,3,4,5,6,7\n");
+  EXPECT_NE(far.find("far.csv:3: 'x_mm' = 1e200 is not a plausible pose value"), std::string::npos) << far;
   std::filesystem::remove_all(dir);
 }
 
