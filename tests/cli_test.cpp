@@ -362,6 +362,13 @@ TEST(Cli, AFrameRangeOutsideTheInputIsAnError) {
   const CliRun r = gtrack(track_of(dir) + " --no-overlay --frames 20:30 -o " + (dir / "out").string());
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("holds 3 frames, none of them in --frames 20:30"), std::string::npos) << r.output;
+  // --out naming a file: one line, resumed or not.
+  const fs::path file = write("a_file", "text");
+  for (const std::string resume : {"", " --resume"}) {
+    const CliRun f = gtrack(track_of(dir) + " --no-overlay" + resume + " -o " + file.string());
+    EXPECT_EQ(f.code, 1);
+    EXPECT_EQ(f.output, "gtrack: error: " + file.string() + ": is a file; expected an output folder (--out)\n");
+  }
 }
 
 // eval reads its tables strictly: what it cannot read is named, with the

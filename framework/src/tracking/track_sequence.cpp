@@ -150,6 +150,12 @@ void warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o) {
 TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
   const auto start = Clock::now();
   // Inputs are checked before anything is written.
+  {
+    std::error_code ec;
+    if (fs::exists(options.out_dir, ec) && !fs::is_directory(options.out_dir, ec)) {
+      throw InputError(options.out_dir.string() + ": is a file; expected an output folder (--out)");
+    }
+  }
   std::optional<StimulusLog> log;
   if (options.follow_stimulus && !options.stimulus_csv) {
     throw InputError("following the stimulus log needs a log (--stimulus FILE)");
