@@ -199,9 +199,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
     return ec ? path : p.string();
   };
-  const std::string run = "input=" + (options.input.rfind("camera:", 0) == 0 ? options.input : absolute(options.input)) +
-                          " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
-                          (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none"));
+  // (Control characters escaped, so that any path fits on the state's line.)
+  const std::string run =
+      shown("input=" + (options.input.rfind("camera:", 0) == 0 ? options.input : absolute(options.input)) +
+                " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
+                (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")),
+            1 << 16);
   if (options.resume && fs::exists(state_file)) {
     resumed = read_tracker_state(state_file);
     if (!resumed->run.empty() && resumed->run != run) {
