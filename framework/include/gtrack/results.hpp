@@ -48,6 +48,10 @@ GTRACK_API int remove_frame_images(const std::filesystem::path& dir);
 // nothing of the two is mixed. Returns how many were removed.
 GTRACK_API int clear_previous_run(const std::filesystem::path& out_dir);
 
+// Whether out_dir's estimates.csv holds a row after its header (a run that
+// tracked at least one frame, its last row perhaps cut short).
+GTRACK_API bool holds_estimates(const std::filesystem::path& out_dir);
+
 // Prepares out_dir for a resumed run: keeps the rows of estimates.csv and
 // estimates.jsonl up to frame `last` (a row cut short by an interruption, or
 // written after the state was, is dropped) and returns the frame indices

@@ -229,6 +229,13 @@ int clear_previous_run(const fs::path& out_dir) {
   return static_cast<int>(stale.size()) + remove_frame_images(out_dir / "masks");
 }
 
+bool holds_estimates(const fs::path& out_dir) {
+  std::ifstream in(out_dir / "estimates.csv");
+  int lines = 0;
+  for (std::string line; lines < 2 && std::getline(in, line);) lines += line.empty() ? 0 : 1;
+  return lines > 1;
+}
+
 std::vector<int> resume_results(const fs::path& out_dir, int fingers, int last) {
   const fs::path csv = out_dir / "estimates.csv", jsonl = out_dir / "estimates.jsonl";
   if (!fs::exists(csv)) throw InputError(csv.string() + ": missing; there is nothing to resume");

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <opencv2/core.hpp>
@@ -217,13 +216,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   } else if (options.resume) {
     // Estimates without the state they end with cannot be continued, and
     // starting over would replace them.
-    const fs::path estimates = options.out_dir / "estimates.csv";
-    std::ifstream in(estimates);
-    std::string line;
-    int rows = 0;
-    while (rows < 2 && std::getline(in, line)) rows += line.empty() ? 0 : 1;
-    if (rows > 1) {
-      throw InputError(estimates.string() + ": holds tracked frames but " + state_file.filename().string() +
+    if (holds_estimates(options.out_dir)) {
+      throw InputError((options.out_dir / "estimates.csv").string() + ": holds tracked frames but " +
+                       state_file.filename().string() +
                        " is missing; cannot resume (a new run would replace them: choose another --out, or run "
                        "without --resume)");
     }

@@ -80,8 +80,8 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
       continue;
     }
     if (key == "run") {
-      s.run = line.size() > 4 ? line.substr(4) : std::string();
-      if (line.size() < 4 || line[3] != ' ' || s.run.empty()) fail("expected the run's input after 'run '");
+      if (line.rfind("run ", 0) != 0 || line.size() == 4) fail("expected the run's input after 'run '");
+      s.run = line.substr(4);
       continue;
     }
     if (key == "last" || key == "before_last" || key == "found_step") {
