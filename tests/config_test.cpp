@@ -102,4 +102,41 @@ TEST(Config, MissingFileIsOneLine) {
   EXPECT_NE(e.find("/nonexistent/x.toml"), std::string::npos);
 }
 
+// The first key whose value differs, in file order; comments, the order of
+// keys and 32 against 32.0 do not count.
+TEST(Config, FirstDifferenceNamesTheKeyAndBothValues) {
+  const std::string base =
+      "plugin_path = [\"a\"]\n[pso]\nparticles = 32\nw = 0.4\n[gripper]\nplugin = \"g\"\n"
+      "[[gripper.links]]\nlength = 1.0\n[[gripper.links]]\nlength = 2.0\n";
+  const auto a = gtrack::ConfigTable::parse(base, "a.toml");
+  const auto same = gtrack::ConfigTable::parse(
+      "# a note\nplugin_path = [\"a\"]\n[gripper]\nplugin = \"g\"\n[[gripper.links]]\nlength = 1\n[[gripper.links]]\nlength = 2\n"
+      "[pso]\nw = 0.4   # inertia\nparticles = 32.0\n",
+      "b.toml");
+  EXPECT_FALSE(gtrack::first_difference(a, same).has_value());
+  EXPECT_FALSE(gtrack::first_difference(a, a).has_value());
+
+  const auto diff = [&](const std::string& text) {
+    const auto d = gtrack::first_difference(a, gtrack::ConfigTable::parse(text, "c.toml"));
+    return d ? d->key + ": " + d->first + " / " + d->second : std::string("none");
+  };
+  std::string changed = base;
+  changed.replace(changed.find("32"), 2, "64");
+  EXPECT_EQ(diff(changed), "[pso] particles: 32 / 64");
+  EXPECT_EQ(diff(base + "[tracker]\nmirror_check = false\n"), "tracker: not set / a table");
+  std::string nested = base;
+  nested.replace(nested.find("2.0"), 3, "2.5");
+  EXPECT_EQ(diff(nested), "[gripper] links: [{ length = 1 }, { length = 2 }] / [{ length = 1 }, { length = 2.5 }]");
+  std::string missing = base;
+  missing.erase(missing.find("w = 0.4\n"), 8);
+  EXPECT_EQ(diff(missing), "[pso] w: 0.4 / not set");
+  std::string text = base;
+  text.replace(text.find("\"g\""), 3, "\"h\"");
+  EXPECT_EQ(diff(text), "[gripper] plugin: 'g' / 'h'");
+  EXPECT_EQ(diff("plugin_path = \"a\"\n[pso]\nparticles = 32\nw = 0.4\n"), "plugin_path: ['a'] / 'a'");
+  // A table's own serialisation reads back as the same config.
+  EXPECT_FALSE(gtrack::first_difference(a.table("pso"),
+                                        gtrack::ConfigTable::parse(a.table("pso").toml_text())).has_value());
+}
+
 }  // namespace

@@ -267,6 +267,13 @@ TEST(Fault, GreyFramesForAColourSegmentationAreSaidOnce) {
   EXPECT_NE(grey_log.find("000000.png: " + said), std::string::npos) << grey_log;
   EXPECT_EQ(grey_log.find(said), grey_log.rfind(said)) << "said once: " << grey_log;
   EXPECT_EQ(warnings_of(colour, dir / "out_colour").find(said), std::string::npos);
+  // One grey image among colour ones is said at that image.
+  cv::Mat grey;
+  cv::cvtColor(frame_image(1), grey, cv::COLOR_BGR2GRAY);
+  cv::imwrite((colour / "000001.png").string(), grey);
+  const std::string mixed_log = warnings_of(colour, dir / "out_mixed");
+  EXPECT_NE(mixed_log.find("000001.png: " + said), std::string::npos) << mixed_log;
+  EXPECT_EQ(mixed_log.find(said), mixed_log.rfind(said)) << "said once: " << mixed_log;
 }
 
 // A folder whose image becomes unreadable part way: the run stops at that
@@ -706,6 +713,36 @@ TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
   EXPECT_EQ(track_error(r, again), "");
   EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_EQ(read_lines(jsonl).size(), 8u);
+}
+
+// A run goes on with the config its first frames were tracked with: the
+// config is kept beside the results, and another one is refused, naming
+// the key; the same config written otherwise (a comment more) resumes.
+TEST(Fault, ResumeRefusesAnotherConfig) {
+  const auto [r, o] = stopped_run("resume_config");
+  const fs::path kept = o.out_dir / "config.toml";
+  ASSERT_TRUE(fs::exists(kept));
+  EXPECT_NE(read_text(kept).find(kConfig), std::string::npos);
+  const fs::path csv = o.out_dir / "estimates.csv";
+  const std::string csv_text = read_text(csv);
+  gtrack::TrackOptions again = o;
+  again.range.last = -1;
+  again.resume = true;
+  expect_refusal_naming(track_error(make_run("mirror_check = false\n"), again),
+                        "config.toml: [tracker] mirror_check was not set in the interrupted run, is false in "
+                        "fault.toml; cannot resume with another config");
+  EXPECT_EQ(read_text(csv), csv_text);
+  // A damaged copy is named by its line, and nothing is changed.
+  const std::string kept_text = read_text(kept);
+  std::ofstream(kept) << kept_text << "[pso\n";
+  expect_refusal_naming(track_error(r, again), "config.toml:");
+  EXPECT_EQ(read_text(csv), csv_text);
+  std::ofstream(kept) << kept_text;
+  TrackRun commented{gtrack::load_setup(gtrack::ConfigTable::parse("# a note\n" + kConfig, "fault.toml"), {}), {}};
+  commented.config = gtrack::engine_config(commented.setup);
+  EXPECT_EQ(track_error(commented, again), "");
+  EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(read_text(kept), kept_text);
 }
 
 // A plugin whose factory throws: the executable exits non-zero with one line

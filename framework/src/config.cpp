@@ -22,6 +22,7 @@ struct ConfigTable::Impl {
   std::string path;
   std::shared_ptr<std::set<std::string>> used = std::make_shared<std::set<std::string>>();
   int line = 0;  // where the table starts, for keys that are missing
+  std::shared_ptr<const std::string> text;  // the document's text, as parsed
 };
 
 namespace {
@@ -144,6 +145,7 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
   impl->table = impl->root.get();
   impl->source = std::move(source);
   impl->line = 1;
+  impl->text = std::make_shared<const std::string>(text);
   return ConfigTable(impl);
 }
 
@@ -160,6 +162,105 @@ ConfigTable ConfigTable::load_file(const std::string& path) {
 
 const std::string& ConfigTable::source() const { return impl_->source; }
 const std::string& ConfigTable::path() const { return impl_->path; }
+
+std::string ConfigTable::toml_text() const {
+  if (impl_->text && impl_->table == impl_->root.get()) return *impl_->text;
+  std::ostringstream s;
+  if (impl_->table) s << *impl_->table << "\n";
+  return s.str();
+}
+
+namespace {
+
+// A value as a message shows it: numbers with up to 15 digits (0.4, not
+// toml++'s 0.40000000000000002), arrays and inline tables written out.
+void write_value(std::ostream& s, const toml::node& n) {
+  if (const auto x = as_number(n)) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.15g", *x);
+    s << b;
+  } else if (const toml::array* a = n.as_array()) {
+    s << "[";
+    for (size_t i = 0; i < a->size(); ++i) {
+      s << (i ? ", " : "");
+      write_value(s, *a->get(i));
+    }
+    s << "]";
+  } else if (const toml::table* t = n.as_table()) {
+    s << "{";
+    const char* sep = " ";
+    for (auto&& [k, v] : *t) {
+      s << sep << k.str() << " = ";
+      write_value(s, v);
+      sep = ", ";
+    }
+    s << " }";
+  } else {
+    n.visit([&s](auto&& v) { s << v; });
+  }
+}
+
+std::string value_text(const toml::node& n) {
+  if (n.is_table()) return "a table";
+  std::ostringstream s;
+  write_value(s, n);
+  return shown(s.str(), 80);
+}
+
+// Keys of both tables, in the first's file order, then the second's.
+std::vector<std::string> keys_of_both(const toml::table& a, const toml::table& b) {
+  std::vector<std::pair<std::pair<int, int>, std::string>> ks;
+  for (auto&& [k, v] : a) ks.push_back({{0, static_cast<int>(v.source().begin.line)}, std::string(k.str())});
+  for (auto&& [k, v] : b) {
+    if (!a.contains(k.str())) ks.push_back({{1, static_cast<int>(v.source().begin.line)}, std::string(k.str())});
+  }
+  std::stable_sort(ks.begin(), ks.end());
+  std::vector<std::string> out;
+  for (auto& [at, k] : ks) out.push_back(std::move(k));
+  return out;
+}
+
+std::optional<ConfigDifference> table_difference(const toml::table& a, const toml::table& b, const std::string& path);
+
+bool same_value(const toml::node& a, const toml::node& b) {
+  const auto x = as_number(a), y = as_number(b);
+  if (x || y) return x && y && *x == *y;
+  if (a.type() != b.type()) return false;
+  if (const toml::table* t = a.as_table()) return !table_difference(*t, *b.as_table(), "");
+  if (const toml::array* u = a.as_array()) {
+    const toml::array& v = *b.as_array();
+    if (u->size() != v.size()) return false;
+    for (size_t i = 0; i < u->size(); ++i) {
+      if (!same_value(*u->get(i), *v.get(i))) return false;
+    }
+    return true;
+  }
+  return value_text(a) == value_text(b);
+}
+
+std::optional<ConfigDifference> table_difference(const toml::table& a, const toml::table& b, const std::string& path) {
+  for (const std::string& k : keys_of_both(a, b)) {
+    const toml::node* x = a.get(k);
+    const toml::node* y = b.get(k);
+    if (x && y && x->is_table() && y->is_table()) {
+      if (auto d = table_difference(*x->as_table(), *y->as_table(), path.empty() ? k : path + "." + k)) return d;
+      continue;
+    }
+    if (x && y && same_value(*x, *y)) continue;
+    return ConfigDifference{(path.empty() ? "" : "[" + path + "] ") + shown(k, 60),
+                            x ? value_text(*x) : "not set", y ? value_text(*y) : "not set"};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<ConfigDifference> first_difference(const ConfigTable& first, const ConfigTable& second) {
+  static const toml::table empty;
+  const toml::table* a = first.impl_->table;
+  const toml::table* b = second.impl_->table;
+  return table_difference(a ? *a : empty, b ? *b : empty, first.path());
+}
 
 std::string ConfigTable::where(std::string_view key) const {
   std::ostringstream s;

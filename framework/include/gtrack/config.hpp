@@ -31,6 +31,19 @@ struct Range {
   static Range closed(double lo, double hi) { return {lo, hi, false, false}; }
 };
 
+class ConfigTable;
+
+// Where two configs differ: the first key (in file order) whose value is
+// not the same in both, as "[table] key" ("key" at the top level), and its
+// value in each ("not set" where it is missing). Numbers compare by value
+// (32 and 32.0 are the same); comments and the order of keys do not count.
+struct ConfigDifference {
+  std::string key;
+  std::string first;
+  std::string second;
+};
+GTRACK_API std::optional<ConfigDifference> first_difference(const ConfigTable& first, const ConfigTable& second);
+
 class GTRACK_API ConfigTable {
  public:
   // An empty table that belongs to no file (for defaults and tests).
@@ -88,6 +101,9 @@ class GTRACK_API ConfigTable {
   const std::string& source() const;
   // Dotted path of this table inside its file ("" for the root).
   const std::string& path() const;
+  // The table as TOML: for the root of a parsed document, the text it was
+  // parsed from, comments included; otherwise its keys written out.
+  std::string toml_text() const;
 
   // Throws ConfigError "file:line: [path] key 'k': <message>".
   [[noreturn]] void fail(std::string_view key, std::string_view message) const;
@@ -95,6 +111,7 @@ class GTRACK_API ConfigTable {
   struct Impl;
 
  private:
+  friend std::optional<ConfigDifference> first_difference(const ConfigTable&, const ConfigTable&);
   explicit ConfigTable(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };

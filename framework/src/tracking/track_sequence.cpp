@@ -18,6 +18,7 @@
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
 #include "nearest_equivalent.hpp"
+#include "replace_file.hpp"
 
 namespace gtrack {
 
@@ -131,17 +132,58 @@ PoseTable read_gripper_poses(const fs::path& file, const Setup& setup, bool trut
 
 // A grey image (its three channels equal: a grayscale or 16-bit grey file
 // read as colour) has no saturation, so a colour segmentation that needs
-// some finds nothing in it: said once, at the first frame, instead of
-// every frame coming out lost without a word.
-void warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o) {
-  if (o.color_space != "hsv" || !(o.saturation_min > 0) || frame.image.channels() != 3) return;
+// some finds nothing in it: said once, at the first frame or at the first
+// frame that finds nothing (a grey image among colour ones), instead of
+// frames coming out lost without a word. True when said.
+bool warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o, bool first) {
+  if (o.color_space != "hsv" || !(o.saturation_min > 0) || frame.image.channels() != 3) return false;
   cv::Mat channels[3];
   cv::split(frame.image, channels);
-  if (cv::countNonZero(channels[0] != channels[1]) > 0 || cv::countNonZero(channels[1] != channels[2]) > 0) return;
+  if (cv::countNonZero(channels[0] != channels[1]) > 0 || cv::countNonZero(channels[1] != channels[2]) > 0) {
+    return false;
+  }
   logger().warn("{}: a grey image, but [observation] color_space = \"hsv\" with saturation_min = {} finds "
-                "nothing without colour; every frame will be lost (for grey images use color_space = "
-                "\"luminance\")",
-                frame.name, o.saturation_min);
+                "nothing without colour; {} (for grey images use color_space = \"luminance\")",
+                frame.name, o.saturation_min,
+                first ? "every frame will be lost" : "it is lost, and every grey image after it");
+  return true;
+}
+
+// The config a run was made with, kept beside its results: what made them,
+// and what a resumed run must go on with.
+constexpr const char* kRunConfig = "config.toml";
+
+void write_run_config(const fs::path& file, const ConfigTable& root) {
+  std::string from = root.source();
+  if (!from.empty() && from.front() != '<') {
+    std::error_code ec;
+    const fs::path p = fs::absolute(from, ec);
+    if (!ec) from = p.lexically_normal().string();
+  }
+  detail::replace_file(file, "# gtrack track: the config of the run in this folder, as read from " +
+                                 shown(from.empty() ? std::string("<config>") : from, 1 << 12) +
+                                 "\n# (relative paths in it are taken from that file's folder); --resume checks "
+                                 "that the config is unchanged\n" +
+                                 root.toml_text());
+}
+
+// A resumed run goes on with the config of the frames already done; a run
+// from an earlier release, without the copy, is not checked.
+void check_same_config(const fs::path& file, const ConfigTable& root) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return;
+  std::optional<ConfigDifference> d;
+  try {
+    d = first_difference(ConfigTable::load_file(file.string()), root);
+  } catch (const Error& e) {
+    throw InputError(std::string(e.what()) + "; cannot resume (this is the interrupted run's config)");
+  }
+  if (!d) return;
+  const std::string now = root.source().empty() ? std::string("this config") : root.source();
+  throw InputError(file.string() + ": " + d->key + " was " + d->first + " in the interrupted run, is " +
+                   d->second + " in " + now +
+                   "; cannot resume with another config (give the run's own config, kept in this file, or "
+                   "another --out)");
 }
 
 }  // namespace
@@ -211,6 +253,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                        "; this one " + shown(run, 300) +
                        "; cannot resume (give the same --input, --every and --stimulus, or another --out)");
     }
+    check_same_config(options.out_dir / kRunConfig, setup.root);
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
@@ -281,6 +324,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
   }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
+  if (!resumed) write_run_config(options.out_dir / kRunConfig, setup.root);
   if (options.save_masks) {
     std::error_code ec;
     fs::create_directories(options.out_dir / "masks", ec);
@@ -318,6 +362,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   double cost_sum = 0, ms_sum = 0;
   StageTimes sums;
   int previous_index = -1;  // the last frame tracked by this run
+  bool warned_grey = false;
   for (;;) {
     if (options.cancel && options.cancel->load()) {
       summary.cancelled = true;
@@ -334,8 +379,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
       if (row != restart_rows.end()) tracker.set_estimate(row->second);
     }
-    if (summary.frames == 0) warn_if_grey_for_colour(*frame, config.observation);
+    if (summary.frames == 0) warned_grey = warn_if_grey_for_colour(*frame, config.observation, true);
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
+    if (!warned_grey && e.observed_pixels == 0) {
+      warned_grey = warn_if_grey_for_colour(*frame, config.observation, false);
+    }
     previous_index = frame->index;
     if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
       // Of the reference's symmetric equivalents, the one nearest the estimate.
