@@ -1,33 +1,239 @@
 // pinhole_microscope: a camera on a microscope, modelled as a pinhole with
-// optional lens distortion (OpenCV's model). World = camera frame, OpenCV
+// optional lens distortion (OpenCV's model), given in the config or read
+// from a calibration file (OpenCV's or ROS's). World = camera frame, OpenCV
 // axes: x right, y down, z forward. Distortion is removed from input frames
 // (rectify) so that the renderers use the linear projection.
 #include <gtrack/plugin.hpp>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/persistence.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <optional>
+#include <string>
+#include <vector>
+
 namespace {
+
+// A camera calibration as OpenCV and ROS write it (cv::FileStorage: YAML,
+// XML or JSON): OpenCV's calibration sample and calibrateCamera users
+// ("camera_matrix", "distortion_coefficients", "image_width",
+// "image_height"), OpenCV's interactive calibration ("cameraMatrix",
+// "dist_coeffs", "cameraResolution"), ROS camera_info files (the same
+// names as the sample, each matrix a map of rows, cols and data).
+struct Calibration {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::vector<double> distortion;  // empty, or 4, 5 or 8 coefficients
+  int width = 0, height = 0;       // 0: the file does not say
+};
+
+// The numbers of a node: a sequence, a single number, or a matrix (a map
+// whose "data" is the sequence: !!opencv-matrix and ROS alike).
+std::optional<std::vector<double>> numbers_of(const cv::FileNode& node) {
+  const cv::FileNode data = node.isMap() ? node["data"] : node;
+  std::vector<double> out;
+  if (data.isInt() || data.isReal()) {
+    out.push_back(static_cast<double>(data));
+  } else if (data.isSeq()) {
+    for (const cv::FileNode& v : data) {
+      if (!v.isInt() && !v.isReal()) return std::nullopt;
+      out.push_back(static_cast<double>(v));
+    }
+  } else {
+    return std::nullopt;
+  }
+  return out;
+}
+
+Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
+  namespace fs = std::filesystem;
+  fs::path file = t.string(key);
+  // A relative path is taken from the config's folder.
+  if (file.is_relative() && !t.source().empty() && t.source().front() != '<') {
+    file = fs::path(t.source()).parent_path() / file;
+  }
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    t.fail(key, name + (fs::exists(file, ec) ? ": not a file" : ": no such file") +
+                    "; expected a camera calibration (OpenCV or ROS, YAML, XML or JSON)");
+  }
+  // Read as text: a ROS file is YAML without the "%YAML:1.0" line that
+  // OpenCV's reader requires, which is then put in front.
+  std::string text;
+  {
+    std::ifstream f(file, std::ios::binary);
+    std::ostringstream s;
+    s << f.rdbuf();
+    if (!f) t.fail(key, name + ": cannot read");
+    text = s.str();
+  }
+  const size_t start = text.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+  int format = cv::FileStorage::FORMAT_YAML;
+  bool prefixed = false;
+  if (start != std::string::npos && text[start] == '<') {
+    format = cv::FileStorage::FORMAT_XML;
+  } else if (start != std::string::npos && text[start] == '{') {
+    format = cv::FileStorage::FORMAT_JSON;
+  } else if (text.compare(start == std::string::npos ? 0 : start, 5, "%YAML") != 0) {
+    text = "%YAML:1.0\n---\n" + text;
+    prefixed = true;
+  }
+  cv::FileStorage in;
+  try {
+    in.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | format);
+  } catch (const cv::Exception& e) {
+    // OpenCV's parser puts "(line): what" where the function's name goes.
+    const std::string& where = e.func;
+    const size_t close = where.find("): ");
+    if (!where.empty() && where[0] == '(' && close != std::string::npos) {
+      long line = std::strtol(where.c_str() + 1, nullptr, 10) - (prefixed ? 2 : 0);
+      t.fail(key, name + ":" + std::to_string(std::max(line, 1L)) + ": " + where.substr(close + 3) +
+                      " (not readable as a calibration)");
+    }
+    t.fail(key, name + ": not readable as a calibration (" + e.err.substr(0, e.err.find('\n')) + ")");
+  }
+  if (!in.isOpened()) t.fail(key, name + ": not readable as a calibration (OpenCV or ROS, YAML, XML or JSON)");
+  const auto first_of = [&](std::initializer_list<const char*> names) -> std::pair<std::string, cv::FileNode> {
+    for (const char* n : names) {
+      cv::FileNode node = in[n];
+      if (!node.empty()) return {n, node};
+    }
+    return {"", cv::FileNode()};
+  };
+  const auto numbers = [&](const std::pair<std::string, cv::FileNode>& entry) {
+    const auto v = numbers_of(entry.second);
+    if (!v) t.fail(key, name + ": '" + entry.first + "' is not a list or matrix of numbers");
+    for (const double x : *v) {
+      if (!std::isfinite(x)) t.fail(key, name + ": '" + entry.first + "' holds a value that is not finite");
+    }
+    return *v;
+  };
+  Calibration c;
+  const auto camera = first_of({"camera_matrix", "cameraMatrix", "K"});
+  if (camera.first.empty()) {
+    t.fail(key, name + ": no camera matrix; expected 'camera_matrix' (OpenCV, ROS) or 'cameraMatrix'");
+  }
+  const std::vector<double> k = numbers(camera);
+  if (k.size() != 9) {
+    t.fail(key, name + ": '" + camera.first + "' has " + std::to_string(k.size()) + " values; expected a 3x3 matrix");
+  }
+  c.fx = k[0];
+  c.cx = k[2];
+  c.fy = k[4];
+  c.cy = k[5];
+  if (!(c.fx > 0 && c.fy > 0) || k[3] != 0 || k[6] != 0 || k[7] != 0 || k[8] != 1) {
+    t.fail(key, name + ": '" + camera.first + "' is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > 0");
+  }
+  if (std::abs(k[1]) > 1e-9 * c.fx) {
+    t.fail(key, name + ": '" + camera.first + "' has a skew (" + std::to_string(k[1]) +
+                    "), which this sensor does not model");
+  }
+  if (const auto model = in["distortion_model"]; !model.empty()) {
+    const std::string m = model.isString() ? static_cast<std::string>(model) : std::string("?");
+    if (m != "plumb_bob" && m != "rational_polynomial") {
+      t.fail(key, name + ": distortion_model '" + m +
+                      "'; this sensor models OpenCV's plumb_bob and rational_polynomial lenses");
+    }
+  }
+  const auto dist = first_of({"distortion_coefficients", "dist_coeffs", "distCoeffs", "D"});
+  if (!dist.first.empty()) {
+    std::vector<double> d = numbers(dist);
+    for (const double x : d) {
+      if (std::abs(x) > 1000) t.fail(key, name + ": '" + dist.first + "' holds a coefficient beyond +-1000");
+    }
+    // Thin-prism and tilt terms (coefficients 9-14) that are zero are no
+    // terms at all; 1-8 coefficients are completed with zeros.
+    while (d.size() > 8 && d.back() == 0) d.pop_back();
+    if (d.size() > 8) {
+      t.fail(key, name + ": '" + dist.first + "' has " + std::to_string(d.size()) +
+                      " coefficients with thin-prism or tilt terms; this sensor models k1, k2, p1, p2, k3, k4, k5, k6");
+    }
+    if (!d.empty()) d.resize(d.size() <= 4 ? 4 : d.size() == 5 ? 5 : 8, 0.0);
+    c.distortion = d;
+  }
+  const auto size_number = [&](const char* n) {
+    const cv::FileNode node = in[n];
+    if (node.empty()) return 0;
+    if (!node.isInt() || static_cast<int>(node) < 1 || static_cast<int>(node) > 65536) {
+      t.fail(key, name + ": '" + n + "' is not an image size in pixels (an integer in 1-65536)");
+    }
+    return static_cast<int>(node);
+  };
+  c.width = size_number("image_width");
+  c.height = size_number("image_height");
+  if (c.width == 0 && c.height == 0) {
+    if (const auto res = first_of({"cameraResolution"}); !res.first.empty()) {
+      const std::vector<double> wh = numbers(res);
+      if (wh.size() != 2 || !(wh[0] >= 1 && wh[0] <= 65536 && wh[1] >= 1 && wh[1] <= 65536) ||
+          wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1])) {
+        t.fail(key, name + ": 'cameraResolution' is not [width, height] in pixels");
+      }
+      c.width = static_cast<int>(wh[0]);
+      c.height = static_cast<int>(wh[1]);
+    }
+  }
+  if ((c.width == 0) != (c.height == 0)) {
+    t.fail(key, name + ": gives one of image_width and image_height without the other");
+  }
+  return c;
+}
 
 class PinholeMicroscope final : public gtrack::Sensor {
  public:
   explicit PinholeMicroscope(const gtrack::ConfigTable& t) {
     using gtrack::Range;
-    width_ = static_cast<int>(t.integer("width", Range{1, 65536}));
-    height_ = static_cast<int>(t.integer("height", Range{1, 65536}));
-    fx_ = t.number("fx", Range::positive());
-    fy_ = t.number_or("fy", fx_, Range::positive());
-    // cx, cy as calibration tools give them (OpenCV: pixel centres on integers).
-    // A principal point far outside the image is a unit or typing mistake.
-    cx_ = t.number_or("cx", (width_ - 1) / 2.0, Range::closed(-10.0 * width_, 11.0 * width_));
-    cy_ = t.number_or("cy", (height_ - 1) / 2.0, Range::closed(-10.0 * height_, 11.0 * height_));
+    if (t.has("calibration")) {
+      // The intrinsics from a calibration file: none of them is given twice.
+      for (const char* key : {"fx", "fy", "cx", "cy", "distortion"}) {
+        if (t.has(key)) {
+          t.fail(key, "is set by the calibration file ([sensor] calibration); give one or the other");
+        }
+      }
+      const Calibration c = read_calibration(t, "calibration");
+      width_ = static_cast<int>(t.integer_or("width", c.width, Range{1, 65536}));
+      height_ = static_cast<int>(t.integer_or("height", c.height, Range{1, 65536}));
+      if (c.width > 0 && (width_ != c.width || height_ != c.height)) {
+        t.fail(t.has("width") ? "width" : "height",
+               "the calibration file was made for " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                   " images, the config says " + std::to_string(width_) + "x" + std::to_string(height_));
+      }
+      if (width_ <= 0 || height_ <= 0) {
+        t.fail("width", "missing; expected the image size (the calibration file does not give it)");
+      }
+      fx_ = c.fx;
+      fy_ = c.fy;
+      cx_ = c.cx;
+      cy_ = c.cy;
+      dist_ = c.distortion;
+      if (!(cx_ >= -10.0 * width_ && cx_ <= 11.0 * width_ && cy_ >= -10.0 * height_ && cy_ <= 11.0 * height_)) {
+        t.fail("calibration", "the principal point (" + std::to_string(cx_) + ", " + std::to_string(cy_) +
+                                  ") lies far outside the " + std::to_string(width_) + "x" +
+                                  std::to_string(height_) + " image; is the file for another camera?");
+      }
+    } else {
+      width_ = static_cast<int>(t.integer("width", Range{1, 65536}));
+      height_ = static_cast<int>(t.integer("height", Range{1, 65536}));
+      fx_ = t.number("fx", Range::positive());
+      fy_ = t.number_or("fy", fx_, Range::positive());
+      // cx, cy as calibration tools give them (OpenCV: pixel centres on integers).
+      // A principal point far outside the image is a unit or typing mistake.
+      cx_ = t.number_or("cx", (width_ - 1) / 2.0, Range::closed(-10.0 * width_, 11.0 * width_));
+      cy_ = t.number_or("cy", (height_ - 1) / 2.0, Range::closed(-10.0 * height_, 11.0 * height_));
+      // Real lenses stay well inside +-1000, even in the rational model.
+      dist_ = t.numbers_or("distortion", {}, std::nullopt, Range::closed(-1000, 1000));
+      if (!(dist_.empty() || dist_.size() == 4 || dist_.size() == 5 || dist_.size() == 8)) {
+        t.fail("distortion", "expected 4, 5 or 8 coefficients (k1, k2, p1, p2[, k3[, k4, k5, k6]]), got " +
+                                 std::to_string(dist_.size()));
+      }
+    }
     near_ = t.number_or("near_mm", 1.0, Range::positive());
     working_distance_ = t.number_or("working_distance_mm", 100.0, Range::positive());
-    // Real lenses stay well inside +-1000, even in the rational model.
-    dist_ = t.numbers_or("distortion", {}, std::nullopt, Range::closed(-1000, 1000));
-    if (!(dist_.empty() || dist_.size() == 4 || dist_.size() == 5 || dist_.size() == 8)) {
-      t.fail("distortion", "expected 4, 5 or 8 coefficients (k1, k2, p1, p2[, k3[, k4, k5, k6]]), got " +
-                               std::to_string(dist_.size()));
-    }
     if (near_ >= working_distance_) t.fail("near_mm", "must be less than working_distance_mm");
     K_ = (cv::Mat_<double>(3, 3) << fx_, 0, cx_, 0, fy_, cy_, 0, 0, 1);
     has_distortion_ = false;
