@@ -143,7 +143,7 @@ GTRACK_COMMAND(
     "track", "track a gripper in a video, an image folder or a live camera",
     [](po::options_description& d) {
       d.add_options()("config,c", po::value<std::string>()->required(), "TOML config naming sensor, gripper, stimulus")(
-          "input,i", po::value<std::string>()->required(), "video file, folder of images, or camera:N")(
+          "input,i", po::value<std::string>()->required(), "video file, folder of images, TIFF stack, or camera:N")(
           "stimulus,s", po::value<std::string>(), "stimulus log CSV (frame,value or time_s,value)")(
           "out,o", po::value<std::string>()->required(), "output folder")(
           "backend", po::value<std::string>(), "auto, gl or cpu (default: [render] backend)")(

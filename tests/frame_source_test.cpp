@@ -4,6 +4,7 @@
 #include <gtrack/frame_source.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -158,6 +159,71 @@ TEST(RecordedFrames, AFoldersBlocksAreItsImagesAndAMissingOneIsNamed) {
     FAIL() << "a removed image went unnoticed";
   } catch (const gtrack::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("frame 10 can no longer be read"), std::string::npos) << e.what();
+  }
+}
+
+// A TIFF stack (ImageJ/Fiji, Micro-Manager): each page is a frame, 16-bit
+// and grey pages included; a range skips the pages before it, and the
+// backward pass reads its blocks by page.
+TEST(FrameSource, EachPageOfATiffStackIsAFrame) {
+  const fs::path dir = folder_of("tiff_stack", {});
+  std::vector<cv::Mat> pages;
+  for (int i = 0; i < 9; ++i) pages.push_back(numbered_frame(i));
+  const fs::path stack = dir / "stack.TIF";
+  ASSERT_TRUE(cv::imwritemulti(stack.string(), pages));
+  gtrack::FrameRange r = gtrack::parse_frame_range("2:9");
+  r.every = 3;
+  auto src = gtrack::open_frame_source(stack.string(), {128, 96}, r, 25);
+  EXPECT_EQ(src->frame_count(), 9);
+  std::vector<int> seen;
+  while (auto f = src->next()) {
+    seen.push_back(f->index);
+    EXPECT_EQ(cv::norm(f->image, pages[static_cast<std::size_t>(f->index)], cv::NORM_INF), 0) << f->index;
+    EXPECT_DOUBLE_EQ(f->time_s, f->index / 25.0);
+  }
+  EXPECT_EQ(seen, (std::vector<int>{2, 5, 8}));
+  gtrack::RecordedFrames recording(stack.string(), {128, 96}, {0, 1, 2, 3, 4, 5, 6, 7, 8}, 1, 25);
+  const auto block = recording.read(6, 9);
+  ASSERT_EQ(block.size(), 3u);
+  EXPECT_EQ(cv::norm(block.at(7), pages[7], cv::NORM_INF), 0);
+  EXPECT_FALSE(recording.seeks());
+
+  // 16-bit grey pages, as cameras write them: grey BGR at a 257th.
+  std::vector<cv::Mat> deep;
+  for (int i = 0; i < 3; ++i) deep.push_back(cv::Mat(96, 128, CV_16UC1, cv::Scalar(257 * (40 + 10 * i))));
+  const fs::path deep_stack = dir / "deep.tiff";
+  ASSERT_TRUE(cv::imwritemulti(deep_stack.string(), deep));
+  auto deep_src = gtrack::open_frame_source(deep_stack.string(), {128, 96}, {}, 25);
+  int n = 0;
+  while (auto f = deep_src->next()) {
+    ASSERT_EQ(f->image.type(), CV_8UC3);
+    EXPECT_EQ(f->image.at<cv::Vec3b>(5, 5), cv::Vec3b::all(static_cast<uchar>(40 + 10 * n)));
+    ++n;
+  }
+  EXPECT_EQ(n, 3);
+
+  // A page of another size is named; a file that is no TIFF is one line.
+  pages[4] = cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(9));
+  ASSERT_TRUE(cv::imwritemulti(stack.string(), pages));
+  auto mixed = gtrack::open_frame_source(stack.string(), {128, 96}, {}, 25);
+  try {
+    while (mixed->next()) {
+    }
+    FAIL() << "a page of another size was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stack.TIF page 4: image is 64x48 but the sensor expects 128x96"),
+              std::string::npos)
+        << e.what();
+  }
+  const fs::path fake = dir / "notes.tif";
+  std::ofstream(fake) << "not an image\n";
+  try {
+    gtrack::open_frame_source(fake.string(), {128, 96}, {}, 25);
+    FAIL() << "a text file was read as a stack";
+  } catch (const gtrack::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("notes.tif: cannot read as a TIFF stack"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
 }
 

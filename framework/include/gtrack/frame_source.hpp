@@ -1,8 +1,9 @@
 // Where frames come from: a video file, a folder of images, or a live camera.
 //
 // open_frame_source() decides by the string: "camera:N" opens device N, an
-// existing folder is read as its image files sorted by name, anything else is
-// opened as a video with cv::VideoCapture. Every frame must have the sensor's
+// existing folder is read as its image files sorted by name, a .tif/.tiff
+// file as a stack whose pages are the frames (a single page: one frame),
+// anything else is opened as a video with cv::VideoCapture. Every frame must have the sensor's
 // image size; a mismatch is an InputError naming the file (or frame) and both
 // sizes. Frame indices count every frame of the source, including frames
 // skipped by `every` or outside the range, so results line up with the input.

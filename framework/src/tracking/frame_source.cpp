@@ -318,6 +318,94 @@ class FolderSource final : public FrameSource {
   int index_ = 0;
 };
 
+// A multi-page TIFF (a stack as ImageJ/Fiji, Micro-Manager and most
+// microscope software save a recording): each page is a frame. Pages are
+// decoded a block at a time, in order; the pages before the range's first
+// are skipped without decoding (TIFF directories only).
+bool is_tiff_file(const std::string& spec) {
+  std::error_code ec;
+  if (!fs::is_regular_file(spec, ec)) return false;
+  std::string ext = fs::path(spec).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".tif" || ext == ".tiff";
+}
+
+class StackSource final : public FrameSource {
+ public:
+  StackSource(std::string spec, ImageSize expected, FrameRange range, double fps)
+      : spec_(std::move(spec)), expected_(expected), filter_(range), range_(range), fps_(fps) {
+    detail::CapturedStderr library;  // libtiff's warnings about private tags (ImageJ's, OME's)
+    count_ = static_cast<int>(cv::imcount(spec_, kFlags));
+    const std::string said = library.take();
+    if (count_ <= 0) {
+      throw InputError(spec_ + ": cannot read as a TIFF stack (corrupt or unsupported" +
+                       (said.empty() ? std::string(")") : "; the decoder said: " + said + ")"));
+    }
+    if (!said.empty()) logger().debug("{}: the decoder said: {}", spec_, said);
+    index_ = std::max(0, range.first);
+  }
+
+  std::optional<Frame> next() override {
+    while (index_ < count_ && !filter_.done(index_) && !filter_.wanted(index_)) ++index_;
+    if (index_ >= count_ || filter_.done(index_)) return std::nullopt;
+    if (index_ < block_first_ || index_ >= block_first_ + static_cast<int>(block_.size())) read_block(index_);
+    Frame f;
+    f.index = index_;
+    f.time_s = fps_ > 0 ? index_ / fps_ : 0.0;
+    f.name = spec_ + " page " + std::to_string(index_);
+    f.image = to_bgr(block_[static_cast<size_t>(index_ - block_first_)]);
+    check_size(f.image, expected_, f.name);
+    ++index_;
+    return f;
+  }
+  double fps() const override { return fps_; }
+  int frame_count() const override { return count_; }
+  std::string description() const override { return spec_ + " (a TIFF stack of " + std::to_string(count_) + " pages)"; }
+
+ private:
+  static constexpr int kFlags = cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH;
+
+  // The pages from `first` on, up to about 256 MB of them when every page
+  // is wanted, else the one page (those between are not decoded).
+  void read_block(int first) {
+    int n = 1;
+    if (range_.every <= 1) {
+      const double page_bytes = std::max(1.0, 3.0 * expected_.width * expected_.height);
+      n = static_cast<int>(std::clamp(256e6 / page_bytes, 1.0, 64.0));
+      n = std::min(n, count_ - first);
+      if (range_.last >= 0) n = std::min(n, range_.last - first);
+      n = std::max(n, 1);
+    }
+    block_.clear();
+    block_first_ = first;
+    detail::CapturedStderr library;
+    bool ok = false;
+    try {
+      ok = cv::imreadmulti(spec_, block_, first, n, kFlags);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    const std::string said = library.take();
+    if (!ok || block_.empty() || std::any_of(block_.begin(), block_.end(), [](const cv::Mat& m) { return m.empty(); })) {
+      block_.clear();
+      throw InputError(spec_ + ": page " + std::to_string(first) + " of " + std::to_string(count_) +
+                       " cannot be read (corrupt or unsupported" +
+                       (said.empty() ? std::string(")") : "; the decoder said: " + said + ")"));
+    }
+    if (!said.empty()) logger().debug("{} page {}: the decoder said: {}", spec_, first, said);
+  }
+
+  std::string spec_;
+  ImageSize expected_;
+  RangeFilter filter_;
+  FrameRange range_;
+  double fps_;
+  int count_ = 0;
+  int index_ = 0;
+  std::vector<cv::Mat> block_;
+  int block_first_ = 0;
+};
+
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
                                         double fallback_fps, bool seek) {
   std::error_code ec;
@@ -365,7 +453,7 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
     }
   }
   std::error_code ec;
-  video_ = !fs::is_directory(spec_, ec);
+  video_ = !fs::is_directory(spec_, ec) && !is_tiff_file(spec_);
 }
 
 std::map<int, cv::Mat> RecordedFrames::fingerprint_in_order(std::size_t lo, std::size_t hi) {
@@ -491,6 +579,7 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   const fs::path p(spec);
   std::error_code ec;
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
+  if (is_tiff_file(spec)) return std::make_unique<StackSource>(spec, expected, range, fallback_fps);
   return open_video(spec, expected, range, fallback_fps, false);  // a missing path: "no such file or folder"
 }
 
