@@ -720,7 +720,7 @@ TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
 // the key; the same config written otherwise (a comment more) resumes.
 TEST(Fault, ResumeRefusesAnotherConfig) {
   const auto [r, o] = stopped_run("resume_config");
-  const fs::path kept = o.out_dir / "config.toml";
+  const fs::path kept = o.out_dir / "run_config.toml";
   ASSERT_TRUE(fs::exists(kept));
   EXPECT_NE(read_text(kept).find(kConfig), std::string::npos);
   const fs::path csv = o.out_dir / "estimates.csv";
@@ -729,13 +729,13 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   again.range.last = -1;
   again.resume = true;
   expect_refusal_naming(track_error(make_run("mirror_check = false\n"), again),
-                        "config.toml: [tracker] mirror_check was not set in the interrupted run, is false in "
+                        "run_config.toml: [tracker] mirror_check was not set in the interrupted run, is false in "
                         "fault.toml; cannot resume with another config");
   EXPECT_EQ(read_text(csv), csv_text);
   // A damaged copy is named by its line, and nothing is changed.
   const std::string kept_text = read_text(kept);
   std::ofstream(kept) << kept_text << "[pso\n";
-  expect_refusal_naming(track_error(r, again), "config.toml:");
+  expect_refusal_naming(track_error(r, again), "run_config.toml:");
   EXPECT_EQ(read_text(csv), csv_text);
   std::ofstream(kept) << kept_text;
   TrackRun commented{gtrack::load_setup(gtrack::ConfigTable::parse("# a note\n" + kConfig, "fault.toml"), {}), {}};
@@ -743,6 +743,22 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   EXPECT_EQ(track_error(commented, again), "");
   EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_EQ(read_text(kept), kept_text);
+  // The copy given as a fresh run's config is copied with one header.
+  TrackRun from_copy{gtrack::load_setup(kept, {}), {}};
+  from_copy.config = gtrack::engine_config(from_copy.setup);
+  gtrack::TrackOptions fresh = o;
+  fresh.out_dir = o.out_dir.parent_path() / "from_copy";
+  EXPECT_EQ(track_error(from_copy, fresh), "");
+  const std::string copied = read_text(fresh.out_dir / "run_config.toml");
+  EXPECT_NE(copied.find(kConfig), std::string::npos);
+  EXPECT_EQ(copied.find("# gtrack track:"), copied.rfind("# gtrack track:")) << copied;
+  // A file of the user's own under that name is not replaced.
+  fresh.out_dir = o.out_dir.parent_path() / "users_file";
+  fs::create_directories(fresh.out_dir);
+  std::ofstream(fresh.out_dir / "run_config.toml") << "my notes\n";
+  expect_refusal_naming(track_error(r, fresh), "run_config.toml: exists and was not written by gtrack track");
+  EXPECT_EQ(read_text(fresh.out_dir / "run_config.toml"), "my notes\n");
+  EXPECT_FALSE(fs::exists(fresh.out_dir / "estimates.csv"));
 }
 
 // A plugin whose factory throws: the executable exits non-zero with one line

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <opencv2/core.hpp>
@@ -150,8 +151,17 @@ bool warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o, boo
 }
 
 // The config a run was made with, kept beside its results: what made them,
-// and what a resumed run must go on with.
-constexpr const char* kRunConfig = "config.toml";
+// and what a resumed run must go on with. Its first line says whose it is,
+// so that a file of the user's own under that name is never replaced.
+constexpr const char* kRunConfig = "run_config.toml";
+constexpr std::string_view kRunConfigHeader = "# gtrack track: the config of the run in this folder";
+
+bool written_by_a_run(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  return line.rfind(kRunConfigHeader, 0) == 0;
+}
 
 void write_run_config(const fs::path& file, const ConfigTable& root) {
   std::string from = root.source();
@@ -160,11 +170,18 @@ void write_run_config(const fs::path& file, const ConfigTable& root) {
     const fs::path p = fs::absolute(from, ec);
     if (!ec) from = p.lexically_normal().string();
   }
-  detail::replace_file(file, "# gtrack track: the config of the run in this folder, as read from " +
+  // A run's own copy given as the config is copied without its header.
+  std::string text = root.toml_text();
+  for (int line = 0; line < 2 && text.rfind("# ", 0) == 0 && (line > 0 || text.rfind(kRunConfigHeader, 0) == 0);
+       ++line) {
+    const size_t end = text.find('\n');
+    text.erase(0, end == std::string::npos ? text.size() : end + 1);
+  }
+  detail::replace_file(file, std::string(kRunConfigHeader) + ", as read from " +
                                  shown(from.empty() ? std::string("<config>") : from, 1 << 12) +
                                  "\n# (relative paths in it are taken from that file's folder); --resume checks "
                                  "that the config is unchanged\n" +
-                                 root.toml_text());
+                                 text);
 }
 
 // A resumed run goes on with the config of the frames already done; a run
@@ -317,7 +334,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   if (resumed) {
     done = resume_results(options.out_dir, setup.model().fingers(), resumed->frame);
   } else {
-    // A fresh run replaces whatever an earlier one left in the folder.
+    // A fresh run replaces whatever an earlier one left in the folder,
+    // and nothing else.
+    const fs::path kept = options.out_dir / kRunConfig;
+    if (fs::exists(kept) && !written_by_a_run(kept)) {
+      throw InputError(kept.string() + ": exists and was not written by gtrack track, which keeps a run's config "
+                       "there; move it, or choose another --out");
+    }
     const bool earlier = fs::exists(options.out_dir / "estimates.csv");
     if (clear_previous_run(options.out_dir) > 0 || earlier) {
       logger().info("{} holds an earlier run: it is replaced", options.out_dir.string());
