@@ -134,6 +134,11 @@ TEST(Config, FirstDifferenceNamesTheKeyAndBothValues) {
   text.replace(text.find("\"g\""), 3, "\"h\"");
   EXPECT_EQ(diff(text), "[gripper] plugin: 'g' / 'h'");
   EXPECT_EQ(diff("plugin_path = \"a\"\n[pso]\nparticles = 32\nw = 0.4\n"), "plugin_path: ['a'] / 'a'");
+  // Long values differ where they differ, beyond what a message shows.
+  const std::string long_name(200, 'x');
+  const auto long_a = gtrack::ConfigTable::parse("note = \"" + long_name + "a\"\n");
+  const auto long_b = gtrack::ConfigTable::parse("note = \"" + long_name + "b\"\n");
+  EXPECT_TRUE(gtrack::first_difference(long_a, long_b).has_value());
   // A table's own serialisation reads back as the same config.
   EXPECT_FALSE(gtrack::first_difference(a.table("pso"),
                                         gtrack::ConfigTable::parse(a.table("pso").toml_text())).has_value());

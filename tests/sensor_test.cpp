@@ -198,6 +198,7 @@ TEST(PinholeMicroscope, BadCalibrationFilesAreOneLineNamingFileAndKey) {
                "garbage.yml:3: Missing , between the elements (not readable as a calibration)");
   // A ROS file has no "%YAML" line: the line named is still the file's own.
   expect_error(write("garbage_ros.yaml", "image_width: 640\ncamera_matrix: [1, 2\n"), "garbage_ros.yaml:2: ");
+  expect_error(write("list.yml", "%YAML:1.0\n---\n- 1\n- 2\n"), "list.yml: not a calibration (expected named entries");
   expect_error(write("nomatrix.yml", "%YAML:1.0\n---\nimage_width: 640\n"), "no camera matrix");
   expect_error(write("short.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400]\n"),
                "'camera_matrix' has 5 values; expected a 3x3 matrix");

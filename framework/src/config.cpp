@@ -235,7 +235,10 @@ bool same_value(const toml::node& a, const toml::node& b) {
     }
     return true;
   }
-  return value_text(a) == value_text(b);
+  std::ostringstream x_text, y_text;  // whole, where value_text cuts a long one short
+  write_value(x_text, a);
+  write_value(y_text, b);
+  return x_text.str() == y_text.str();
 }
 
 std::optional<ConfigDifference> table_difference(const toml::table& a, const toml::table& b, const std::string& path) {

@@ -99,6 +99,9 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     t.fail(key, name + ": not readable as a calibration (" + e.err.substr(0, e.err.find('\n')) + ")");
   }
   if (!in.isOpened()) t.fail(key, name + ": not readable as a calibration (OpenCV or ROS, YAML, XML or JSON)");
+  if (!in.root().empty() && !in.root().isMap()) {
+    t.fail(key, name + ": not a calibration (expected named entries such as camera_matrix, not a list)");
+  }
   const auto first_of = [&](std::initializer_list<const char*> names) -> std::pair<std::string, cv::FileNode> {
     for (const char* n : names) {
       cv::FileNode node = in[n];
