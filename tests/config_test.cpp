@@ -139,6 +139,12 @@ TEST(Config, FirstDifferenceNamesTheKeyAndBothValues) {
   const auto long_a = gtrack::ConfigTable::parse("note = \"" + long_name + "a\"\n");
   const auto long_b = gtrack::ConfigTable::parse("note = \"" + long_name + "b\"\n");
   EXPECT_TRUE(gtrack::first_difference(long_a, long_b).has_value());
+  // Integers beyond 2^53 compare exactly; nan is the same as nan.
+  EXPECT_TRUE(gtrack::first_difference(gtrack::ConfigTable::parse("n = 9007199254740993\n"),
+                                       gtrack::ConfigTable::parse("n = 9007199254740992\n"))
+                  .has_value());
+  EXPECT_FALSE(gtrack::first_difference(gtrack::ConfigTable::parse("x = nan\n"), gtrack::ConfigTable::parse("x = nan\n"))
+                   .has_value());
   // A table's own serialisation reads back as the same config.
   EXPECT_FALSE(gtrack::first_difference(a.table("pso"),
                                         gtrack::ConfigTable::parse(a.table("pso").toml_text())).has_value());

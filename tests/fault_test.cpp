@@ -735,7 +735,8 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   // A damaged copy is named by its line, and nothing is changed.
   const std::string kept_text = read_text(kept);
   std::ofstream(kept) << kept_text << "[pso\n";
-  expect_refusal_naming(track_error(r, again), "run_config.toml:");
+  const auto lines = std::count(kept_text.begin(), kept_text.end(), '\n');
+  expect_refusal_naming(track_error(r, again), "run_config.toml:" + std::to_string(lines + 1) + ": ");
   EXPECT_EQ(read_text(csv), csv_text);
   std::ofstream(kept) << kept_text;
   TrackRun commented{gtrack::load_setup(gtrack::ConfigTable::parse("# a note\n" + kConfig, "fault.toml"), {}), {}};

@@ -210,6 +210,9 @@ TEST(PinholeMicroscope, BadCalibrationFilesAreOneLineNamingFileAndKey) {
   expect_error(write("tilt.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"
                                  "distortion_coefficients: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.01, 0]\n"),
                "has 13 coefficients with thin-prism or tilt terms");
+  // A ROS file that opens its document with "---": its own lines are named.
+  expect_error(write("dashes.yaml", "---\nimage_width: 640\ncamera_matrix: [1, 2\n"), "dashes.yaml:3: ");
   expect_error(write("nosize.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"),
                "key 'width': missing; expected the image size");
+  expect_error(head + (dir / "nosize.yml").string() + "\"\nwidth = 640", "key 'height': missing; expected the image size");
 }

@@ -223,8 +223,11 @@ std::vector<std::string> keys_of_both(const toml::table& a, const toml::table& b
 std::optional<ConfigDifference> table_difference(const toml::table& a, const toml::table& b, const std::string& path);
 
 bool same_value(const toml::node& a, const toml::node& b) {
+  // Integers exactly (beyond 2^53 a double cannot tell them apart), an
+  // integer and a float by value, nan as itself.
+  if (a.is_integer() && b.is_integer()) return *a.value_exact<int64_t>() == *b.value_exact<int64_t>();
   const auto x = as_number(a), y = as_number(b);
-  if (x || y) return x && y && *x == *y;
+  if (x || y) return x && y && (*x == *y || (std::isnan(*x) && std::isnan(*y)));
   if (a.type() != b.type()) return false;
   if (const toml::table* t = a.as_table()) return !table_difference(*t, *b.as_table(), "");
   if (const toml::array* u = a.as_array()) {

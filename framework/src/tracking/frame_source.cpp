@@ -365,11 +365,14 @@ class StackSource final : public FrameSource {
  private:
   static constexpr int kFlags = cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH;
 
-  // The pages from `first` on, up to about 256 MB of them when every page
-  // is wanted, else the one page (those between are not decoded).
+  // The pages from `first` on, up to 64 and about 256 MB of them; with
+  // --every above 16, the one page. Each read walks the TIFF's directories
+  // from its first page, so one read per wanted page would cost the square
+  // of the stack's length: a block decodes the pages between wanted ones
+  // too, and is cheaper up to a stride of about 16.
   void read_block(int first) {
     int n = 1;
-    if (range_.every <= 1) {
+    if (range_.every <= 16) {
       const double page_bytes = std::max(1.0, 3.0 * expected_.width * expected_.height);
       n = static_cast<int>(std::clamp(256e6 / page_bytes, 1.0, 64.0));
       n = std::min(n, count_ - first);

@@ -170,8 +170,10 @@ void write_run_config(const fs::path& file, const ConfigTable& root) {
     const fs::path p = fs::absolute(from, ec);
     if (!ec) from = p.lexically_normal().string();
   }
-  // A run's own copy given as the config is copied without its header.
+  // A run's own copy given as the config is copied without its header; a
+  // byte-order mark goes, or it would stand on the copy's third line.
   std::string text = root.toml_text();
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
   for (int line = 0; line < 2 && text.rfind("# ", 0) == 0 && (line > 0 || text.rfind(kRunConfigHeader, 0) == 0);
        ++line) {
     const size_t end = text.find('\n');
@@ -199,8 +201,8 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
   const std::string now = root.source().empty() ? std::string("this config") : root.source();
   throw InputError(file.string() + ": " + d->key + " was " + d->first + " in the interrupted run, is " +
                    d->second + " in " + now +
-                   "; cannot resume with another config (give the run's own config, kept in this file, or "
-                   "another --out)");
+                   "; cannot resume with another config (give the config the run was started with, which this file "
+                   "copies and names, or another --out)");
 }
 
 }  // namespace

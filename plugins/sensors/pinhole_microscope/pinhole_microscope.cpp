@@ -75,14 +75,16 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
   }
   const size_t start = text.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
   int format = cv::FileStorage::FORMAT_YAML;
-  bool prefixed = false;
+  long prefixed_lines = 0;
   if (start != std::string::npos && text[start] == '<') {
     format = cv::FileStorage::FORMAT_XML;
   } else if (start != std::string::npos && text[start] == '{') {
     format = cv::FileStorage::FORMAT_JSON;
   } else if (text.compare(start == std::string::npos ? 0 : start, 5, "%YAML") != 0) {
-    text = "%YAML:1.0\n---\n" + text;
-    prefixed = true;
+    // A file that opens its document ("---") needs only the version line.
+    const bool opened = text.compare(start == std::string::npos ? 0 : start, 3, "---") == 0;
+    text = (opened ? "%YAML:1.0\n" : "%YAML:1.0\n---\n") + text;
+    prefixed_lines = opened ? 1 : 2;
   }
   cv::FileStorage in;
   try {
@@ -92,7 +94,7 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     const std::string& where = e.func;
     const size_t close = where.find("): ");
     if (!where.empty() && where[0] == '(' && close != std::string::npos) {
-      long line = std::strtol(where.c_str() + 1, nullptr, 10) - (prefixed ? 2 : 0);
+      long line = std::strtol(where.c_str() + 1, nullptr, 10) - prefixed_lines;
       t.fail(key, name + ":" + std::to_string(std::max(line, 1L)) + ": " + where.substr(close + 3) +
                       " (not readable as a calibration)");
     }
@@ -207,7 +209,8 @@ class PinholeMicroscope final : public gtrack::Sensor {
                    " images, the config says " + std::to_string(width_) + "x" + std::to_string(height_));
       }
       if (width_ <= 0 || height_ <= 0) {
-        t.fail("width", "missing; expected the image size (the calibration file does not give it)");
+        t.fail(width_ <= 0 ? "width" : "height",
+               "missing; expected the image size (the calibration file does not give it)");
       }
       fx_ = c.fx;
       fy_ = c.fy;
