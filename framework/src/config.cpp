@@ -382,6 +382,12 @@ std::string ConfigTable::string_or(std::string_view key, std::string fallback) c
   return string(key);
 }
 
+std::filesystem::path ConfigTable::file_path(std::string_view key) const {
+  const std::filesystem::path file = string(key);
+  if (file.is_relative() && !impl_->source.empty()) return std::filesystem::path(impl_->source).parent_path() / file;
+  return file;
+}
+
 std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
                                    const std::vector<std::string>& allowed) const {
   std::string v = string_or(key, std::move(fallback));

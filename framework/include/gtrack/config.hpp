@@ -9,6 +9,7 @@
 // 'fx'?)". Every getter that fails throws ConfigError with file, line and key.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -68,6 +69,9 @@ class GTRACK_API ConfigTable {
   bool boolean_or(std::string_view key, bool fallback) const;
   std::string string(std::string_view key) const;
   std::string string_or(std::string_view key, std::string fallback) const;
+  // A string naming a file; a relative path is taken from the folder of the
+  // config file this table came from (as it stands without one).
+  std::filesystem::path file_path(std::string_view key) const;
   // A string that must be one of `allowed`; the error lists them.
   std::string choice_or(std::string_view key, std::string fallback,
                         const std::vector<std::string>& allowed) const;

@@ -35,6 +35,13 @@ void check_size(const cv::Mat& img, ImageSize expected, const std::string& what)
   }
 }
 
+// ".TIF" -> ".tif": extensions are matched whatever their case.
+std::string lowercase_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
 cv::Mat to_bgr(const cv::Mat& img) {
   if (img.type() == CV_8UC3) return img;
   cv::Mat out;
@@ -230,8 +237,7 @@ class FolderSource final : public FrameSource {
       // Hidden files are no frames: a copy's metadata (macOS "._name.png")
       // or an image still being written under a temporary name.
       if (it->path().filename().string().front() == '.') continue;
-      std::string ext = it->path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      const std::string ext = lowercase_extension(it->path());
       if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(it->path());
     }
     if (ec) {
@@ -325,8 +331,7 @@ class FolderSource final : public FrameSource {
 bool is_tiff_file(const std::string& spec) {
   std::error_code ec;
   if (!fs::is_regular_file(spec, ec)) return false;
-  std::string ext = fs::path(spec).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowercase_extension(spec);
   return ext == ".tif" || ext == ".tiff";
 }
 

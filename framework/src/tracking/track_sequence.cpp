@@ -174,10 +174,10 @@ void write_run_config(const fs::path& file, const ConfigTable& root) {
   // byte-order mark goes, or it would stand on the copy's third line.
   std::string text = root.toml_text();
   if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
-  for (int line = 0; line < 2 && text.rfind("# ", 0) == 0 && (line > 0 || text.rfind(kRunConfigHeader, 0) == 0);
-       ++line) {
-    const size_t end = text.find('\n');
-    text.erase(0, end == std::string::npos ? text.size() : end + 1);
+  const auto drop_first_line = [&text] { text.erase(0, std::min(text.find('\n'), text.size() - 1) + 1); };
+  if (text.rfind(kRunConfigHeader, 0) == 0) {
+    drop_first_line();
+    if (text.rfind("# ", 0) == 0) drop_first_line();
   }
   detail::replace_file(file, std::string(kRunConfigHeader) + ", as read from " +
                                  shown(from.empty() ? std::string("<config>") : from, 1 << 12) +
@@ -404,10 +404,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
       if (row != restart_rows.end()) tracker.set_estimate(row->second);
     }
-    if (summary.frames == 0) warned_grey = warn_if_grey_for_colour(*frame, config.observation, true);
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
-    if (!warned_grey && e.observed_pixels == 0) {
-      warned_grey = warn_if_grey_for_colour(*frame, config.observation, false);
+    if (!warned_grey && (summary.frames == 0 || e.observed_pixels == 0)) {
+      warned_grey = warn_if_grey_for_colour(*frame, config.observation, summary.frames == 0);
     }
     previous_index = frame->index;
     if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {

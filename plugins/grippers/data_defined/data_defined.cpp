@@ -109,8 +109,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
 
 gtrack::ArticulatedModel load_model(const ConfigTable& t) {
   if (!t.has("model_file")) return gtrack::ArticulatedModel(read_geometry(t));
-  std::filesystem::path file = t.string("model_file");
-  if (file.is_relative() && !t.source().empty()) file = std::filesystem::path(t.source()).parent_path() / file;
+  const std::filesystem::path file = t.file_path("model_file");
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) t.fail("model_file", file.string() + " is a folder; expected a TOML file");
   if (!std::filesystem::is_regular_file(file, ec)) t.fail("model_file", file.string() + " does not exist");

@@ -52,11 +52,7 @@ std::optional<std::vector<double>> numbers_of(const cv::FileNode& node) {
 
 Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
   namespace fs = std::filesystem;
-  fs::path file = t.string(key);
-  // A relative path is taken from the config's folder.
-  if (file.is_relative() && !t.source().empty() && t.source().front() != '<') {
-    file = fs::path(t.source()).parent_path() / file;
-  }
+  const fs::path file = t.file_path(key);
   const std::string name = file.string();
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) {
