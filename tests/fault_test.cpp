@@ -752,7 +752,9 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   EXPECT_EQ(track_error(from_copy, fresh), "");
   const std::string copied = read_text(fresh.out_dir / "run_config.toml");
   EXPECT_NE(copied.find(kConfig), std::string::npos);
-  EXPECT_EQ(copied.find("# gtrack track:"), copied.rfind("# gtrack track:")) << copied;
+  const std::string first_line = "# gtrack track: the config of the run in this folder";
+  EXPECT_EQ(copied.rfind(first_line, 0), 0u) << copied;
+  EXPECT_EQ(copied.find(first_line), copied.rfind(first_line)) << copied;
   // A file of the user's own under that name is not replaced.
   fresh.out_dir = o.out_dir.parent_path() / "users_file";
   fs::create_directories(fresh.out_dir);
@@ -760,6 +762,87 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   expect_refusal_naming(track_error(r, fresh), "run_config.toml: exists and was not written by gtrack track");
   EXPECT_EQ(read_text(fresh.out_dir / "run_config.toml"), "my notes\n");
   EXPECT_FALSE(fs::exists(fresh.out_dir / "estimates.csv"));
+}
+
+// The files a config names are kept with it: a resumed run refuses a
+// calibration file that changed since the run began, and goes on once it
+// is restored. The copy given back as a config takes its relative paths
+// from the original's folder, not from the output folder it stands in.
+TEST(Fault, ResumeRefusesAChangedFileTheConfigNames) {
+  const fs::path dir = fresh_dir("resume_files");
+  fs::create_directories(dir / "lab");
+  const std::string camera = R"(%YAML:1.0
+---
+image_width: 128
+image_height: 128
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 1600., 0., 63.5, 0., 1600., 63.5, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 1
+   cols: 5
+   dt: d
+   data: [ 0., 0., 0., 0., 0. ]
+)";
+  std::ofstream(dir / "lab" / "camera.yml") << camera;
+  std::string config = kConfig;
+  const std::string keys = "fx = 1600.0\nfy = 1600.0\ncx = 63.5\ncy = 63.5\n";
+  ASSERT_NE(config.find(keys), std::string::npos);
+  config.replace(config.find(keys), keys.size(), "calibration = \"camera.yml\"\n");
+  std::ofstream(dir / "lab" / "lab.toml") << config;
+  const auto load = [](const fs::path& file) {
+    TrackRun r{gtrack::load_setup(file, {}), {}};
+    r.config = gtrack::engine_config(r.setup);
+    return r;
+  };
+  const TrackRun r = load(dir / "lab" / "lab.toml");
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  o.range.last = 3;
+  gtrack::track_sequence(r.setup, r.config, o);
+  const fs::path kept = o.out_dir / "run_config.toml";
+  const std::string camera_path = fs::absolute(dir / "lab" / "camera.yml").lexically_normal().string();
+  EXPECT_NE(read_text(kept).find("# gtrack track: file [sensor] calibration = " + camera_path + ": " +
+                                 std::to_string(camera.size()) + " bytes, FNV-1a 64 "),
+            std::string::npos)
+      << read_text(kept);
+  const fs::path csv = o.out_dir / "estimates.csv";
+  const std::string csv_text = read_text(csv);
+  gtrack::TrackOptions again = o;
+  again.range.last = -1;
+  again.resume = true;
+  // The same config, its calibration changed (the principal point moved).
+  std::string moved = camera;
+  moved.replace(moved.find("63.5"), 4, "60.5");
+  std::ofstream(dir / "lab" / "camera.yml") << moved;
+  expect_refusal_naming(track_error(load(dir / "lab" / "lab.toml"), again),
+                        camera_path + ": has changed since the interrupted run began ([sensor] calibration: it was " +
+                            std::to_string(camera.size()) + " bytes, FNV-1a 64 ");
+  EXPECT_EQ(read_text(csv), csv_text);
+  // The same text in another folder names another file.
+  fs::create_directories(dir / "elsewhere");
+  std::ofstream(dir / "elsewhere" / "camera.yml") << camera;
+  std::ofstream(dir / "elsewhere" / "lab.toml") << config;
+  expect_refusal_naming(track_error(load(dir / "elsewhere" / "lab.toml"), again),
+                        "run_config.toml: [sensor] calibration was the file " + camera_path);
+  EXPECT_EQ(read_text(csv), csv_text);
+  std::ofstream(dir / "lab" / "camera.yml") << camera;
+  EXPECT_EQ(track_error(load(dir / "lab" / "lab.toml"), again), "");
+  EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  // The copy, read from the output folder, finds camera.yml in lab/, and
+  // a run made with it keeps that folder and that file.
+  const TrackRun from_copy = load(kept);
+  gtrack::TrackOptions fresh = o;
+  fresh.out_dir = dir / "from_copy";
+  EXPECT_EQ(track_error(from_copy, fresh), "");
+  const std::string copied = read_text(fresh.out_dir / "run_config.toml");
+  EXPECT_NE(copied.find("# gtrack track: its relative paths start at " +
+                        fs::absolute(dir / "lab").lexically_normal().string() + "\n"),
+            std::string::npos)
+      << copied;
+  EXPECT_NE(copied.find("# gtrack track: file [sensor] calibration = " + camera_path + ": "), std::string::npos)
+      << copied;
 }
 
 // A plugin whose factory throws: the executable exits non-zero with one line

@@ -23,6 +23,9 @@ struct ConfigTable::Impl {
   std::shared_ptr<std::set<std::string>> used = std::make_shared<std::set<std::string>>();
   int line = 0;  // where the table starts, for keys that are missing
   std::shared_ptr<const std::string> text;  // the document's text, as parsed
+  std::filesystem::path base;  // where relative file paths start ("": the source's folder)
+  // The files file_path() gave out, shared by every table of the document.
+  std::shared_ptr<std::vector<NamedFile>> files = std::make_shared<std::vector<NamedFile>>();
 };
 
 namespace {
@@ -108,7 +111,7 @@ ConfigTable::~ConfigTable() = default;
 ConfigTable::ConfigTable(const ConfigTable&) = default;
 ConfigTable& ConfigTable::operator=(const ConfigTable&) = default;
 
-ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
+ConfigTable ConfigTable::parse(std::string_view text, std::string source, std::filesystem::path base_folder) {
   auto impl = std::make_shared<Impl>();
   try {
     impl->root = std::make_shared<toml::table>(toml::parse(text, source));
@@ -146,10 +149,11 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
   impl->source = std::move(source);
   impl->line = 1;
   impl->text = std::make_shared<const std::string>(text);
+  impl->base = std::move(base_folder);
   return ConfigTable(impl);
 }
 
-ConfigTable ConfigTable::load_file(const std::string& path) {
+ConfigTable ConfigTable::load_file(const std::string& path, std::filesystem::path base_folder) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a folder; expected a TOML config file");
   std::ifstream in(path, std::ios::binary);
@@ -157,7 +161,7 @@ ConfigTable ConfigTable::load_file(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   if (in.bad()) throw ConfigError(path + ": cannot read config file");
-  return parse(s.str(), path);
+  return parse(s.str(), path, std::move(base_folder));
 }
 
 const std::string& ConfigTable::source() const { return impl_->source; }
@@ -383,9 +387,25 @@ std::string ConfigTable::string_or(std::string_view key, std::string fallback) c
 }
 
 std::filesystem::path ConfigTable::file_path(std::string_view key) const {
-  const std::filesystem::path file = string(key);
-  if (file.is_relative() && !impl_->source.empty()) return std::filesystem::path(impl_->source).parent_path() / file;
+  std::filesystem::path file = string(key);
+  if (file.is_relative()) file = base_folder() / file;
+  const std::string name = impl_->path.empty() ? std::string(key) : "[" + impl_->path + "] " + std::string(key);
+  auto& files = *impl_->files;
+  const auto known = std::find_if(files.begin(), files.end(), [&](const NamedFile& f) { return f.key == name; });
+  if (known == files.end()) {
+    files.push_back({name, file});
+  } else {
+    known->path = file;
+  }
   return file;
+}
+
+std::vector<NamedFile> ConfigTable::named_files() const { return *impl_->files; }
+
+std::filesystem::path ConfigTable::base_folder() const {
+  if (!impl_->base.empty()) return impl_->base;
+  if (impl_->source.empty() || impl_->source.front() == '<') return {};
+  return std::filesystem::path(impl_->source).parent_path();
 }
 
 std::string ConfigTable::choice_or(std::string_view key, std::string fallback,
@@ -490,6 +510,8 @@ ConfigTable ConfigTable::table(std::string_view key) const {
   auto impl = std::make_shared<Impl>();
   impl->root = impl_->root;
   impl->source = impl_->source;
+  impl->base = impl_->base;
+  impl->files = impl_->files;
   impl->path = impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key);
   impl->line = impl_->line;
   if (n) {
@@ -513,6 +535,8 @@ std::vector<ConfigTable> ConfigTable::tables(std::string_view key) const {
     auto impl = std::make_shared<Impl>();
     impl->root = impl_->root;
     impl->source = impl_->source;
+    impl->base = impl_->base;
+    impl->files = impl_->files;
     impl->path = (impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key)) + "[" +
                  std::to_string(i) + "]";
     impl->table = t;

@@ -6,6 +6,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "tracking/run_config.hpp"
 
 namespace gtrack {
 
@@ -67,7 +68,11 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
 }
 
 Setup load_setup(const fs::path& config_file, const SetupOptions& options) {
-  return load_setup(ConfigTable::load_file(config_file.string()), options);
+  // A run's copy of its config takes its relative paths from where the
+  // original's were taken.
+  return load_setup(ConfigTable::load_file(config_file.string(),
+                                           detail::run_config_base_folder(config_file).value_or(fs::path())),
+                    options);
 }
 
 }  // namespace gtrack

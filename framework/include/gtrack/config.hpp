@@ -34,6 +34,14 @@ struct Range {
 
 class ConfigTable;
 
+// A file a config names, as file_path() resolved it: the key ("[table] key")
+// and the path. A run keeps them with its config, so that --resume can
+// tell when one of them has changed.
+struct NamedFile {
+  std::string key;
+  std::filesystem::path path;
+};
+
 // Where two configs differ: the first key (in file order) whose value is
 // not the same in both, as "[table] key" ("key" at the top level), and its
 // value in each ("not set" where it is missing). Numbers compare by value
@@ -54,9 +62,12 @@ class GTRACK_API ConfigTable {
   ConfigTable& operator=(const ConfigTable&);
 
   // Parses TOML text; `source` names it in errors (a file path or "<string>").
-  static ConfigTable parse(std::string_view toml_text, std::string source = "<string>");
+  // Relative file paths in it are taken from `base_folder`, when given,
+  // else from the folder of `source`.
+  static ConfigTable parse(std::string_view toml_text, std::string source = "<string>",
+                           std::filesystem::path base_folder = {});
   // Reads and parses a file. Throws ConfigError naming the file and line.
-  static ConfigTable load_file(const std::string& path);
+  static ConfigTable load_file(const std::string& path, std::filesystem::path base_folder = {});
 
   bool has(std::string_view key) const;
   // Keys present in this table, in file order.
@@ -70,8 +81,15 @@ class GTRACK_API ConfigTable {
   std::string string(std::string_view key) const;
   std::string string_or(std::string_view key, std::string fallback) const;
   // A string naming a file; a relative path is taken from the folder of the
-  // config file this table came from (as it stands without one).
+  // config file this table came from (as it stands without one). Each path
+  // given out is recorded for named_files().
   std::filesystem::path file_path(std::string_view key) const;
+  // The files file_path() gave out so far, from any table of this document,
+  // in the order asked (a key asked twice is listed once).
+  std::vector<NamedFile> named_files() const;
+  // Where relative file paths start: the folder given to parse() or
+  // load_file(), else the folder of the source ("" without a source).
+  std::filesystem::path base_folder() const;
   // A string that must be one of `allowed`; the error lists them.
   std::string choice_or(std::string_view key, std::string fallback,
                         const std::vector<std::string>& allowed) const;

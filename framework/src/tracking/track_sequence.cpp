@@ -20,6 +20,7 @@
 #include "gtrack/tracker.hpp"
 #include "nearest_equivalent.hpp"
 #include "replace_file.hpp"
+#include "run_config.hpp"
 
 namespace gtrack {
 
@@ -150,61 +151,6 @@ bool warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o, boo
   return true;
 }
 
-// The config a run was made with, kept beside its results: what made them,
-// and what a resumed run must go on with. Its first line says whose it is,
-// so that a file of the user's own under that name is never replaced.
-constexpr const char* kRunConfig = "run_config.toml";
-constexpr std::string_view kRunConfigHeader = "# gtrack track: the config of the run in this folder";
-
-bool written_by_a_run(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::string line;
-  std::getline(in, line);
-  return line.rfind(kRunConfigHeader, 0) == 0;
-}
-
-void write_run_config(const fs::path& file, const ConfigTable& root) {
-  std::string from = root.source();
-  if (!from.empty() && from.front() != '<') {
-    std::error_code ec;
-    const fs::path p = fs::absolute(from, ec);
-    if (!ec) from = p.lexically_normal().string();
-  }
-  // A run's own copy given as the config is copied without its header; a
-  // byte-order mark goes, or it would stand on the copy's third line.
-  std::string text = root.toml_text();
-  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
-  const auto drop_first_line = [&text] { text.erase(0, std::min(text.find('\n'), text.size() - 1) + 1); };
-  if (text.rfind(kRunConfigHeader, 0) == 0) {
-    drop_first_line();
-    if (text.rfind("# ", 0) == 0) drop_first_line();
-  }
-  detail::replace_file(file, std::string(kRunConfigHeader) + ", as read from " +
-                                 shown(from.empty() ? std::string("<config>") : from, 1 << 12) +
-                                 "\n# (relative paths in it are taken from that file's folder); --resume checks "
-                                 "that the config is unchanged\n" +
-                                 text);
-}
-
-// A resumed run goes on with the config of the frames already done; a run
-// from an earlier release, without the copy, is not checked.
-void check_same_config(const fs::path& file, const ConfigTable& root) {
-  std::error_code ec;
-  if (!fs::exists(file, ec)) return;
-  std::optional<ConfigDifference> d;
-  try {
-    d = first_difference(ConfigTable::load_file(file.string()), root);
-  } catch (const Error& e) {
-    throw InputError(std::string(e.what()) + "; cannot resume (this is the interrupted run's config)");
-  }
-  if (!d) return;
-  const std::string now = root.source().empty() ? std::string("this config") : root.source();
-  throw InputError(file.string() + ": " + d->key + " was " + d->first + " in the interrupted run, is " +
-                   d->second + " in " + now +
-                   "; cannot resume with another config (give the config the run was started with, which this file "
-                   "copies and names, or another --out)");
-}
-
 }  // namespace
 
 TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
@@ -272,7 +218,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                        "; this one " + shown(run, 300) +
                        "; cannot resume (give the same --input, --every and --stimulus, or another --out)");
     }
-    check_same_config(options.out_dir / kRunConfig, setup.root);
+    detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root);
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
@@ -338,8 +284,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   } else {
     // A fresh run replaces whatever an earlier one left in the folder,
     // and nothing else.
-    const fs::path kept = options.out_dir / kRunConfig;
-    if (fs::exists(kept) && !written_by_a_run(kept)) {
+    const fs::path kept = options.out_dir / detail::kRunConfigName;
+    if (fs::exists(kept) && !detail::written_by_a_run(kept)) {
       throw InputError(kept.string() + ": exists and was not written by gtrack track, which keeps a run's config "
                        "there; move it, or choose another --out");
     }
@@ -349,7 +295,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
   }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
-  if (!resumed) write_run_config(options.out_dir / kRunConfig, setup.root);
+  if (!resumed) detail::write_run_config(options.out_dir / detail::kRunConfigName, setup.root);
   if (options.save_masks) {
     std::error_code ec;
     fs::create_directories(options.out_dir / "masks", ec);

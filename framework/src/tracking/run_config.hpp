@@ -1,0 +1,38 @@
+// run_config.toml: the config a run was made with, kept beside its results,
+// with the files it names. It says what made the results, and what a
+// resumed run must go on with.
+//
+// The copy is the config's text as read, under a header of comment lines
+// that each start "# gtrack track: ": where the config was read from, the
+// folder its relative paths are taken from, and each file it names with its
+// size and FNV-1a hash. Given back as a config, the copy's relative paths
+// are taken from that folder, as the original's were.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+#include "gtrack/config.hpp"
+
+namespace gtrack::detail {
+
+inline constexpr const char* kRunConfigName = "run_config.toml";
+
+// `file` starts with the header of a run's copy (a file of the user's own
+// under that name is never replaced).
+bool written_by_a_run(const std::filesystem::path& file);
+
+// For a run's copy: the folder its relative paths are taken from.
+// nullopt for any other file, or a copy that names no folder.
+std::optional<std::filesystem::path> run_config_base_folder(const std::filesystem::path& file);
+
+// Writes the copy of `root` (a copy given as the config is copied without
+// its header) with the files root.named_files() lists.
+void write_run_config(const std::filesystem::path& file, const ConfigTable& root);
+
+// Throws InputError, naming the first difference, when `root` is not the
+// config kept in `file`, or a file it names has changed. A run without the
+// copy (from an earlier release) is not checked.
+void check_same_config(const std::filesystem::path& file, const ConfigTable& root);
+
+}  // namespace gtrack::detail
