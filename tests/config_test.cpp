@@ -102,6 +102,30 @@ TEST(Config, MissingFileIsOneLine) {
   EXPECT_NE(e.find("/nonexistent/x.toml"), std::string::npos);
 }
 
+// file_path() takes a relative path from the config's folder, or from the
+// folder given to parse(), and lists each key it resolved once, by its
+// table, for every table of the document.
+TEST(Config, FilePathsAreResolvedAndListed) {
+  const std::string text = "top = \"a.txt\"\n[sensor]\ncalibration = \"cam/c.yml\"\nabs = \"/data/x.yml\"\n";
+  const auto c = gtrack::ConfigTable::parse(text, "/lab/lab.toml");
+  EXPECT_EQ(c.base_folder(), std::filesystem::path("/lab"));
+  EXPECT_TRUE(c.named_files().empty());
+  const auto sensor = c.table("sensor");
+  EXPECT_EQ(sensor.file_path("calibration"), std::filesystem::path("/lab/cam/c.yml"));
+  EXPECT_EQ(sensor.file_path("abs"), std::filesystem::path("/data/x.yml"));
+  EXPECT_EQ(c.file_path("top"), std::filesystem::path("/lab/a.txt"));
+  EXPECT_EQ(sensor.file_path("calibration"), std::filesystem::path("/lab/cam/c.yml"));
+  const auto files = c.named_files();
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_EQ(files[0].key, "[sensor] calibration");
+  EXPECT_EQ(files[1].key, "[sensor] abs");
+  EXPECT_EQ(files[2].key, "top");
+  EXPECT_EQ(files[2].path, std::filesystem::path("/lab/a.txt"));
+  const auto moved = gtrack::ConfigTable::parse(text, "/out/run_config.toml", "/lab");
+  EXPECT_EQ(moved.table("sensor").file_path("calibration"), std::filesystem::path("/lab/cam/c.yml"));
+  EXPECT_EQ(gtrack::ConfigTable::parse(text).file_path("top"), std::filesystem::path("a.txt"));
+}
+
 // The first key whose value differs, in file order; comments, the order of
 // keys and 32 against 32.0 do not count.
 TEST(Config, FirstDifferenceNamesTheKeyAndBothValues) {
