@@ -12,7 +12,11 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/sinks/ostream_sink.h>
+#include <sstream>
+
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 
 namespace fs = std::filesystem;
 
@@ -228,3 +232,58 @@ TEST(FrameSource, EachPageOfATiffStackIsAFrame) {
 }
 
 }  // namespace
+
+namespace {
+
+// The logger's lines while `f` runs.
+template <class F>
+std::string logged(F&& f) {
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  try {
+    f();
+  } catch (...) {
+    gtrack::logger().sinks().pop_back();
+    throw;
+  }
+  gtrack::logger().sinks().pop_back();
+  return log.str();
+}
+
+}  // namespace
+
+// A 12-bit camera stores its values in the low bits of 16-bit files: at
+// the default 16 bits they come out dark, which is warned about once; with
+// image_bits = 12 they fill the 8 bits, in the first pass and when read again.
+TEST(FrameSource, SixteenBitImagesAreScaledByTheirSignificantBits) {
+  const fs::path dir = folder_of("twelve_bits", {});
+  const std::vector<int> values = {4095, 2048, 600};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    cv::Mat img(8, 8, CV_16UC1, cv::Scalar(values[i]));
+    ASSERT_TRUE(cv::imwrite((dir / ("f" + std::to_string(i) + ".png")).string(), img));
+  }
+  std::vector<cv::Vec3b> seen;
+  const std::string warned = logged([&] {
+    auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
+    while (auto f = src->next()) seen.push_back(f->image.at<cv::Vec3b>(3, 3));
+  });
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_EQ(seen[0], cv::Vec3b::all(16));  // 4095 / 257
+  EXPECT_NE(warned.find("f0.png: a 16-bit image whose values reach only 4095 of 65535"), std::string::npos) << warned;
+  EXPECT_NE(warned.find("[tracker] image_bits"), std::string::npos) << warned;
+  EXPECT_EQ(warned.find("f1.png"), std::string::npos) << "warned once: " << warned;
+
+  seen.clear();
+  const std::string quiet = logged([&] {
+    auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
+    src->set_image_bits(12);
+    while (auto f = src->next()) seen.push_back(f->image.at<cv::Vec3b>(3, 3));
+  });
+  EXPECT_EQ(quiet.find("16-bit"), std::string::npos) << quiet;
+  EXPECT_EQ(seen, (std::vector<cv::Vec3b>{cv::Vec3b::all(255), cv::Vec3b::all(128), cv::Vec3b::all(37)}));
+  gtrack::RecordedFrames recording(dir.string(), {8, 8}, {0, 1, 2}, 1, 25);
+  recording.set_image_bits(12);
+  EXPECT_EQ(recording.read(1, 2).at(1).at<cv::Vec3b>(3, 3), cv::Vec3b::all(128));
+  auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
+  EXPECT_THROW(src->set_image_bits(17), std::invalid_argument);
+}

@@ -126,6 +126,9 @@ struct TrackerConfig {
   // x, y, z (mm), rx, ry, rz (deg), joints (deg).
   Eigen::Matrix<double, 7, 1> init_spread = Eigen::Matrix<double, 7, 1>::Zero();
   double fps = 0;                        // 0: from the video, else 30
+  // Significant bits of 16-bit input images (12 for a 12-bit camera that
+  // stores its values in the low bits): scaled to 8 bits by 255 / (2^bits - 1).
+  int image_bits = 16;
   std::optional<double> default_stimulus;  // used when no stimulus log is given
   double lost_dice = 0.95;               // best D above this: the gripper is not where we think
   int reinit_after_lost = 3;             // lost frames before the coarse search takes over

@@ -53,6 +53,19 @@ class GTRACK_API FrameSource {
   // Once next() has ended: why the source ended before the frames it
   // declared (a video the decoder gave up on part way), or "" when it did not.
   virtual std::string ended_early() const { return {}; }
+  // Significant bits of 16-bit images, 8 to 16 (default 16): a 16-bit image
+  // is scaled to 8 bits by 255 / (2^bits - 1), values above 2^bits - 1
+  // saturating. `warn`: the first image whose values use less than a
+  // sixteenth of that range is warned about.
+  void set_image_bits(int bits, bool warn = true);
+
+ protected:
+  // An image as delivered: 8-bit BGR.
+  cv::Mat to_bgr(const cv::Mat& image, const std::string& name);
+
+ private:
+  int image_bits_ = 16;
+  bool warned_bits_ = false;
 };
 
 // A folder that acquisition software is still writing images into: once
@@ -106,6 +119,9 @@ class GTRACK_API RecordedFrames {
   // Blocks read by seeking (the decoder took the seek and the frames were
   // the ones read in order).
   int seeked_blocks() const { return seeked_blocks_; }
+  // As FrameSource::set_image_bits, for every frame read (without the
+  // warning, which the first pass gave).
+  void set_image_bits(int bits) { image_bits_ = bits; }
 
  private:
   std::map<int, cv::Mat> fingerprint_in_order(std::size_t lo, std::size_t hi);
@@ -118,6 +134,7 @@ class GTRACK_API RecordedFrames {
   bool video_ = false;
   bool seeks_ = true;
   int seeked_blocks_ = 0;
+  int image_bits_ = 16;
   std::vector<std::uint64_t> prints_;  // per frame of frames_ (a video, once a block has needed them)
 };
 

@@ -137,6 +137,7 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   // frame a minute to a few hundred thousand a second.
   c.fps = t.number_or("fps", c.fps, Range::closed(0, 1e6));
   if (c.fps > 0 && c.fps < 1e-3) t.fail("fps", "expected 0 (the source's rate) or a rate of at least 0.001 frames/s");
+  c.image_bits = static_cast<int>(t.integer_or("image_bits", c.image_bits, Range::closed(8, 16)));
   if (t.has("default_stimulus")) c.default_stimulus = t.number("default_stimulus", Range::closed(-1e9, 1e9));
   c.lost_dice = t.number_or("lost_dice", c.lost_dice, {0.0, 1.0, true, false});
   c.reinit_after_lost = static_cast<int>(t.integer_or("reinit_after_lost", c.reinit_after_lost, Range::closed(1, 1e6)));

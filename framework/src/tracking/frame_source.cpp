@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <stdexcept>
@@ -24,6 +25,39 @@ namespace fs = std::filesystem;
 
 FrameSource::~FrameSource() = default;
 
+void FrameSource::set_image_bits(int bits, bool warn) {
+  if (bits < 8 || bits > 16) throw std::invalid_argument("FrameSource::set_image_bits: expected 8 to 16 bits");
+  image_bits_ = bits;
+  warned_bits_ = !warn;
+}
+
+cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
+  cv::Mat out;
+  if (image.channels() == 1) cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
+  else if (image.channels() == 4) cv::cvtColor(image, out, cv::COLOR_BGRA2BGR);
+  else out = image;
+  if (out.depth() == CV_8U) return out;
+  if (out.depth() == CV_16U) {
+    const double top = std::ldexp(1.0, image_bits_) - 1.0;
+    if (!warned_bits_) {
+      // Values that stay under a sixteenth of the range: most likely a
+      // camera of fewer bits than said (12-bit data in 16-bit files).
+      double max = 0;
+      cv::minMaxLoc(out.reshape(1), nullptr, &max);
+      if (max > 0 && max < (top + 1) / 16) {
+        logger().warn("{}: a 16-bit image whose values reach only {} of {:.0f}, so it is dark at 8 bits; if the "
+                      "camera gives fewer bits, say so with [tracker] image_bits (now {})",
+                      name, max, top, image_bits_);
+        warned_bits_ = true;
+      }
+    }
+    out.convertTo(out, CV_8U, 255.0 / top);
+    return out;
+  }
+  out.convertTo(out, CV_8U);
+  return out;
+}
+
 namespace {
 
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
@@ -42,15 +76,6 @@ std::string lowercase_extension(const fs::path& p) {
   return ext;
 }
 
-cv::Mat to_bgr(const cv::Mat& img) {
-  if (img.type() == CV_8UC3) return img;
-  cv::Mat out;
-  if (img.channels() == 1) cv::cvtColor(img, out, cv::COLOR_GRAY2BGR);
-  else if (img.channels() == 4) cv::cvtColor(img, out, cv::COLOR_BGRA2BGR);
-  else out = img;
-  if (out.depth() != CV_8U) out.convertTo(out, CV_8U, out.depth() == CV_16U ? 1.0 / 257.0 : 1.0);
-  return out;
-}
 
 // Decides which source indices are delivered, for every kind of source.
 class RangeFilter {
@@ -109,7 +134,7 @@ class VideoSource final : public FrameSource {
       f.index = index_++;
       f.time_s = fps_ > 0 ? f.index / fps_ : 0.0;
       f.name = name_ + " frame " + std::to_string(f.index);
-      f.image = to_bgr(img);
+      f.image = to_bgr(img, f.name);
       check_size(f.image, expected_, f.name);
       ++delivered_;
       return f;
@@ -208,7 +233,7 @@ class FolderSource final : public FrameSource {
         f.index = i;
         f.time_s = fps_ > 0 ? i / fps_ : 0.0;
         f.name = p.string();
-        f.image = to_bgr(read(p));
+        f.image = to_bgr(read(p), f.name);
         check_size(f.image, expected_, p.string());
         return f;
       }
@@ -285,7 +310,7 @@ class FolderSource final : public FrameSource {
     std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
     for (;;) {
       detail::CapturedStderr library;
-      cv::Mat img = cv::imread(p.string(), cv::IMREAD_COLOR);
+      cv::Mat img = cv::imread(p.string(), cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
       const std::string said = library.take();
       if (!following()) {
         if (img.empty()) fail_to_read(p, said);
@@ -358,7 +383,7 @@ class StackSource final : public FrameSource {
     f.index = index_;
     f.time_s = fps_ > 0 ? index_ / fps_ : 0.0;
     f.name = spec_ + " page " + std::to_string(index_);
-    f.image = to_bgr(block_[static_cast<size_t>(index_ - block_first_)]);
+    f.image = to_bgr(block_[static_cast<size_t>(index_ - block_first_)], f.name);
     check_size(f.image, expected_, f.name);
     ++index_;
     return f;
@@ -466,6 +491,7 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
 
 std::map<int, cv::Mat> RecordedFrames::fingerprint_in_order(std::size_t lo, std::size_t hi) {
   auto source = open_video(spec_, expected_, {frames_.front(), frames_.back() + 1, every_}, fps_, false);
+  source->set_image_bits(image_bits_, false);
   std::vector<std::uint64_t> prints(frames_.size(), 0);
   std::map<int, cv::Mat> block;
   while (auto f = source->next()) {
@@ -505,6 +531,7 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
       if (first_wrong(images) == hi) return images;
     } else {
       auto source = open_video(spec_, expected_, range, fps_, true);
+      source->set_image_bits(image_bits_, false);
       auto images = collect(*source);
       if (first_wrong(images) == hi) {
         if (source->seeked()) ++seeked_blocks_;
@@ -513,7 +540,9 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
       seek_failed = true;
     }
   }
-  auto images = collect(*open_frame_source(spec_, expected_, range, fps_));
+  auto source = open_frame_source(spec_, expected_, range, fps_);
+  source->set_image_bits(image_bits_, false);
+  auto images = collect(*source);
   const std::size_t k = first_wrong(images);
   if (k < hi) {
     const bool missing = images.find(frames_[k]) == images.end();

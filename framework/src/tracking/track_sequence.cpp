@@ -235,6 +235,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
                                   config.tracker.fps > 0 ? config.tracker.fps : 30.0,
                                   FollowOptions{options.follow_input_s, options.cancel});
+  source->set_image_bits(config.tracker.image_bits);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
   if (!resumed && expected_frames(*source, range) == 0) {
     throw InputError(options.input + ": holds " + std::to_string(source->frame_count()) +

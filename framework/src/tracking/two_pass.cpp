@@ -215,6 +215,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   indices.reserve(forward.size());
   for (const Estimate& f : forward) indices.push_back(f.frame);
   RecordedFrames recording(options.input, size, indices, every, fps);
+  recording.set_image_bits(config.tracker.image_bits);
   for (int hi = n; hi > 0 && !summary.cancelled; hi -= kBlock) {
     const int lo = std::max(0, hi - kBlock);
     const std::map<int, cv::Mat> images = recording.read(static_cast<std::size_t>(lo), static_cast<std::size_t>(hi));
@@ -250,6 +251,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   range.first = forward.front().frame;
   range.last = forward.back().frame + 1;
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
+  source->set_image_bits(config.tracker.image_bits, false);
   constexpr double kNone = std::numeric_limits<double>::infinity();
   // Per frame, the costs of the two candidates (0 the forward estimate, 1
   // the backward one) on the forward run's conditions, temporal term aside.
