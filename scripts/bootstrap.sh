@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libeigen3-dev libopencv-dev
+  libeigen3-dev libopencv-dev libtiff-dev
   libegl-dev libgl-dev libegl1-mesa-dev libegl-mesa0 libgl1-mesa-dri
   libboost-dev libboost-program-options-dev
   libtomlplusplus-dev libspdlog-dev

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <spdlog/sinks/ostream_sink.h>
+#include <tiffio.h>
 #include <sstream>
 
 #include "gtrack/error.hpp"
@@ -286,4 +287,82 @@ TEST(FrameSource, SixteenBitImagesAreScaledByTheirSignificantBits) {
   EXPECT_EQ(recording.read(1, 2).at(1).at<cv::Vec3b>(3, 3), cv::Vec3b::all(128));
   auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
   EXPECT_THROW(src->set_image_bits(17), std::invalid_argument);
+}
+
+namespace {
+
+// A stack of `pages` grey 16x16 pages, the first described by `description`
+// (as ImageJ and OME-TIFF writers describe theirs).
+void write_described_stack(const fs::path& file, int pages, const std::string& description) {
+  TIFF* tif = TIFFOpen(file.c_str(), "w");
+  ASSERT_NE(tif, nullptr);
+  std::vector<unsigned char> row(16);
+  for (int p = 0; p < pages; ++p) {
+    TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, 16);
+    TIFFSetField(tif, TIFFTAG_IMAGELENGTH, 16);
+    TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 8);
+    TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 1);
+    TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+    TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+    TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, 16);
+    if (p == 0 && !description.empty()) TIFFSetField(tif, TIFFTAG_IMAGEDESCRIPTION, description.c_str());
+    std::fill(row.begin(), row.end(), static_cast<unsigned char>(10 * p));
+    for (int y = 0; y < 16; ++y) ASSERT_EQ(TIFFWriteScanline(tif, row.data(), static_cast<uint32_t>(y), 0), 1);
+    ASSERT_EQ(TIFFWriteDirectory(tif), 1);
+  }
+  TIFFClose(tif);
+}
+
+std::string read_all_logged(const fs::path& file, int every) {
+  gtrack::FrameRange r;
+  r.every = every;
+  return logged([&] {
+    auto src = gtrack::open_frame_source(file.string(), {16, 16}, r, 25);
+    while (src->next()) {
+    }
+  });
+}
+
+}  // namespace
+
+// Every page of a stack is taken as the next frame: a stack whose writer
+// says it holds several channels or z-slices per time point is warned
+// about unless --every steps over them, and so is one that holds fewer
+// pages than its writer says (a copy cut short).
+TEST(FrameSource, AStacksLayoutFromImageJOrOmeIsChecked) {
+  const fs::path dir = folder_of("stack_layout", {});
+  const fs::path two_channels = dir / "two_channels.tif";
+  write_described_stack(two_channels, 6,
+                        "ImageJ=1.54f\nimages=6\nchannels=2\nframes=3\nhyperstack=true\nmode=composite\n");
+  const std::string mixed = read_all_logged(two_channels, 1);
+  EXPECT_NE(mixed.find("two_channels.tif: ImageJ says it holds 2 channel(s) and 1 z-slice(s) per time point"),
+            std::string::npos)
+      << mixed;
+  EXPECT_NE(mixed.find("--every 2"), std::string::npos) << mixed;
+  EXPECT_EQ(read_all_logged(two_channels, 2), "");
+
+  const fs::path cut = dir / "cut.tif";
+  write_described_stack(cut, 4, "ImageJ=1.54f\nimages=300\nframes=300\nfinterval=0.1\n");
+  const std::string short_copy = read_all_logged(cut, 1);
+  EXPECT_NE(short_copy.find("cut.tif: ImageJ says it holds 300 pages, the file has 4"), std::string::npos)
+      << short_copy;
+
+  const fs::path ome = dir / "ome.tif";
+  write_described_stack(ome, 8,
+                        "<?xml version=\"1.0\"?><OME xmlns=\"http://www.openmicroscopy.org/Schemas/OME/2016-06\">"
+                        "<Image ID=\"Image:0\"><Pixels ID=\"Pixels:0\" DimensionOrder=\"XYCZT\" SizeC=\"1\" "
+                        "SizeT=\"4\" SizeX=\"16\" SizeY=\"16\" SizeZ=\"2\" Type=\"uint8\"></Pixels></Image></OME>");
+  const std::string slices = read_all_logged(ome, 1);
+  EXPECT_NE(slices.find("ome.tif: OME-TIFF says it holds 1 channel(s) and 2 z-slice(s) per time point"),
+            std::string::npos)
+      << slices;
+  EXPECT_EQ(slices.find("pages, the file has"), std::string::npos) << slices;
+
+  // A stack that says nothing of its layout, or says it holds what it
+  // holds, is read without a word.
+  const fs::path plain = dir / "plain.tif";
+  write_described_stack(plain, 3, "");
+  EXPECT_EQ(read_all_logged(plain, 1), "");
+  write_described_stack(plain, 3, "ImageJ=1.54f\nimages=3\nframes=3\n");
+  EXPECT_EQ(read_all_logged(plain, 1), "");
 }

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
+#include <tiffio.h>
 
 #include "captured_stderr.hpp"
 #include "gtrack/error.hpp"
@@ -360,19 +361,73 @@ bool is_tiff_file(const std::string& spec) {
   return ext == ".tif" || ext == ".tiff";
 }
 
+// What a stack's first page says of its layout: ImageJ writes "images=",
+// "channels=", "slices=" and "frames=" lines into its description, OME-TIFF
+// (Micro-Manager, Bio-Formats) an XML whose Pixels element has SizeC, SizeZ
+// and SizeT. Pages run channel by channel, then slice by slice, then time
+// point by time point.
+struct StackLayout {
+  std::string writer;  // "ImageJ" or "OME-TIFF"
+  long long images = 0, channels = 1, slices = 1;
+};
+
+std::optional<StackLayout> stack_layout(const std::string& file) {
+  detail::CapturedStderr library;  // libtiff's warnings about private tags
+  TIFF* tif = TIFFOpen(file.c_str(), "r");
+  if (!tif) return std::nullopt;
+  char* text = nullptr;
+  std::string description;
+  if (TIFFGetField(tif, TIFFTAG_IMAGEDESCRIPTION, &text) == 1 && text) description = text;
+  TIFFClose(tif);
+  library.take();
+  // The digits after `key` in `text`, 0 when there are none.
+  const auto number_after = [](std::string_view text, std::string_view key) -> long long {
+    const size_t at = text.find(key);
+    if (at == std::string_view::npos) return 0;
+    long long v = 0;
+    const char* first = text.data() + at + key.size();
+    const auto [end, ec] = std::from_chars(first, text.data() + text.size(), v);
+    return ec == std::errc() && end != first && v <= 1'000'000'000 ? v : 0;
+  };
+  StackLayout layout;
+  if (description.rfind("ImageJ=", 0) == 0) {
+    layout.writer = "ImageJ";
+    const std::string lines = "\n" + description;
+    layout.images = number_after(lines, "\nimages=");
+    layout.channels = std::max(1LL, number_after(lines, "\nchannels="));
+    layout.slices = std::max(1LL, number_after(lines, "\nslices="));
+  } else if (const size_t pixels = description.find("<Pixels "); pixels != std::string::npos &&
+                                                                  description.find("<OME") != std::string::npos) {
+    layout.writer = "OME-TIFF";
+    const std::string_view tag = std::string_view(description).substr(pixels, description.find('>', pixels) - pixels);
+    layout.channels = std::max(1LL, number_after(tag, " SizeC=\""));
+    layout.slices = std::max(1LL, number_after(tag, " SizeZ=\""));
+    const double images = static_cast<double>(layout.channels) * static_cast<double>(layout.slices) *
+                          static_cast<double>(std::max(1LL, number_after(tag, " SizeT=\"")));
+    layout.images = static_cast<long long>(std::min(images, 1e15));
+  } else {
+    return std::nullopt;
+  }
+  return layout;
+}
+
 class StackSource final : public FrameSource {
  public:
   StackSource(std::string spec, ImageSize expected, FrameRange range, double fps)
       : spec_(std::move(spec)), expected_(expected), filter_(range), range_(range), fps_(fps) {
-    detail::CapturedStderr library;  // libtiff's warnings about private tags (ImageJ's, OME's)
-    count_ = static_cast<int>(cv::imcount(spec_, kFlags));
-    const std::string said = library.take();
+    std::string said;
+    {
+      detail::CapturedStderr library;  // libtiff's warnings about private tags (ImageJ's, OME's)
+      count_ = static_cast<int>(cv::imcount(spec_, kFlags));
+      said = library.take();
+    }
     if (count_ <= 0) {
       throw InputError(spec_ + ": cannot read as a TIFF stack (corrupt or unsupported" +
                        (said.empty() ? std::string(")") : "; the decoder said: " + said + ")"));
     }
     if (!said.empty()) logger().debug("{}: the decoder said: {}", spec_, said);
     index_ = std::max(0, range.first);
+    if (const auto layout = stack_layout(spec_)) check_layout(*layout);
   }
 
   std::optional<Frame> next() override {
@@ -394,6 +449,24 @@ class StackSource final : public FrameSource {
 
  private:
   static constexpr int kFlags = cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH;
+
+  // Every page is taken as the next frame: a stack with several channels or
+  // z-slices per time point, unless --every steps over them, and a stack
+  // that holds fewer pages than its writer says, are warned about.
+  void check_layout(const StackLayout& layout) const {
+    const long long per_time = layout.channels * layout.slices;
+    if (per_time > 1 && std::max(1, range_.every) % per_time != 0) {
+      logger().warn("{}: {} says it holds {} channel(s) and {} z-slice(s) per time point, but every page is taken "
+                    "as the next frame; track one channel and slice with --every {} (--frames K: for the K-th "
+                    "page of each time point), or split the stack first",
+                    spec_, layout.writer, layout.channels, layout.slices, per_time);
+    }
+    if (layout.images > count_) {
+      logger().warn("{}: {} says it holds {} pages, the file has {}: a copy cut short, or a recording split over "
+                    "several files; the {} pages there are tracked",
+                    spec_, layout.writer, layout.images, count_, count_);
+    }
+  }
 
   // The pages from `first` on, up to 64 and about 256 MB of them; with
   // --every above 16, the one page. Each read walks the TIFF's directories
