@@ -340,6 +340,12 @@ TEST(FrameSource, AStacksLayoutFromImageJOrOmeIsChecked) {
       << mixed;
   EXPECT_NE(mixed.find("--every 2"), std::string::npos) << mixed;
   EXPECT_EQ(read_all_logged(two_channels, 2), "");
+  // Read again in blocks (the backward pass), it is not warned about again.
+  const std::string again = logged([&] {
+    gtrack::RecordedFrames recording(two_channels.string(), {16, 16}, {0, 1, 2, 3, 4, 5}, 1, 25);
+    EXPECT_EQ(recording.read(0, 6).size(), 6u);
+  });
+  EXPECT_EQ(again, "");
 
   const fs::path cut = dir / "cut.tif";
   write_described_stack(cut, 4, "ImageJ=1.54f\nimages=300\nframes=300\nfinterval=0.1\n");

@@ -55,17 +55,23 @@ class GTRACK_API FrameSource {
   virtual std::string ended_early() const { return {}; }
   // Significant bits of 16-bit images, 8 to 16 (default 16): a 16-bit image
   // is scaled to 8 bits by 255 / (2^bits - 1), values above 2^bits - 1
-  // saturating. `warn`: the first image whose values use less than a
-  // sixteenth of that range is warned about.
-  void set_image_bits(int bits, bool warn = true);
+  // saturating. The first image whose values use less than a sixteenth of
+  // that range is warned about.
+  void set_image_bits(int bits);
+  // Leaves out the warnings about what the input is (a stack's layout, dark
+  // 16-bit images): for a source that reads again what another one has
+  // read and warned about.
+  void set_quiet() { quiet_ = true; }
 
  protected:
   // An image as delivered: 8-bit BGR.
   cv::Mat to_bgr(const cv::Mat& image, const std::string& name);
+  bool quiet() const { return quiet_; }
 
  private:
   int image_bits_ = 16;
   bool warned_bits_ = false;
+  bool quiet_ = false;
 };
 
 // A folder that acquisition software is still writing images into: once

@@ -26,10 +26,9 @@ namespace fs = std::filesystem;
 
 FrameSource::~FrameSource() = default;
 
-void FrameSource::set_image_bits(int bits, bool warn) {
+void FrameSource::set_image_bits(int bits) {
   if (bits < 8 || bits > 16) throw std::invalid_argument("FrameSource::set_image_bits: expected 8 to 16 bits");
   image_bits_ = bits;
-  warned_bits_ = !warn;
 }
 
 cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
@@ -40,7 +39,7 @@ cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
   if (out.depth() == CV_8U) return out;
   if (out.depth() == CV_16U) {
     const double top = std::ldexp(1.0, image_bits_) - 1.0;
-    if (!warned_bits_) {
+    if (!warned_bits_ && !quiet_) {
       // Values that stay under a sixteenth of the range: most likely a
       // camera of fewer bits than said (12-bit data in 16-bit files).
       double max = 0;
@@ -427,10 +426,12 @@ class StackSource final : public FrameSource {
     }
     if (!said.empty()) logger().debug("{}: the decoder said: {}", spec_, said);
     index_ = std::max(0, range.first);
-    if (const auto layout = stack_layout(spec_)) check_layout(*layout);
+    layout_ = stack_layout(spec_);
   }
 
   std::optional<Frame> next() override {
+    if (layout_ && !quiet()) check_layout(*layout_);
+    layout_.reset();
     while (index_ < count_ && !filter_.done(index_) && !filter_.wanted(index_)) ++index_;
     if (index_ >= count_ || filter_.done(index_)) return std::nullopt;
     if (index_ < block_first_ || index_ >= block_first_ + static_cast<int>(block_.size())) read_block(index_);
@@ -510,6 +511,7 @@ class StackSource final : public FrameSource {
   int index_ = 0;
   std::vector<cv::Mat> block_;
   int block_first_ = 0;
+  std::optional<StackLayout> layout_;  // checked at the first frame
 };
 
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
@@ -564,7 +566,8 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
 
 std::map<int, cv::Mat> RecordedFrames::fingerprint_in_order(std::size_t lo, std::size_t hi) {
   auto source = open_video(spec_, expected_, {frames_.front(), frames_.back() + 1, every_}, fps_, false);
-  source->set_image_bits(image_bits_, false);
+  source->set_image_bits(image_bits_);
+  source->set_quiet();
   std::vector<std::uint64_t> prints(frames_.size(), 0);
   std::map<int, cv::Mat> block;
   while (auto f = source->next()) {
@@ -604,7 +607,8 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
       if (first_wrong(images) == hi) return images;
     } else {
       auto source = open_video(spec_, expected_, range, fps_, true);
-      source->set_image_bits(image_bits_, false);
+      source->set_image_bits(image_bits_);
+      source->set_quiet();
       auto images = collect(*source);
       if (first_wrong(images) == hi) {
         if (source->seeked()) ++seeked_blocks_;
@@ -614,7 +618,8 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
     }
   }
   auto source = open_frame_source(spec_, expected_, range, fps_);
-  source->set_image_bits(image_bits_, false);
+  source->set_image_bits(image_bits_);
+  source->set_quiet();
   auto images = collect(*source);
   const std::size_t k = first_wrong(images);
   if (k < hi) {

@@ -251,7 +251,8 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   range.first = forward.front().frame;
   range.last = forward.back().frame + 1;
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
-  source->set_image_bits(config.tracker.image_bits, false);
+  source->set_image_bits(config.tracker.image_bits);
+  source->set_quiet();
   constexpr double kNone = std::numeric_limits<double>::infinity();
   // Per frame, the costs of the two candidates (0 the forward estimate, 1
   // the backward one) on the forward run's conditions, temporal term aside.
