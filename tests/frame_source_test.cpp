@@ -192,6 +192,11 @@ TEST(FrameSource, EachPageOfATiffStackIsAFrame) {
   ASSERT_EQ(block.size(), 3u);
   EXPECT_EQ(cv::norm(block.at(7), pages[7], cv::NORM_INF), 0);
   EXPECT_FALSE(recording.seeks());
+  // The next block reads the stack with the page count the first one found.
+  const auto earlier = recording.read(2, 6);
+  ASSERT_EQ(earlier.size(), 4u);
+  EXPECT_EQ(cv::norm(earlier.at(2), pages[2], cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(earlier.at(5), pages[5], cv::NORM_INF), 0);
 
   // 16-bit grey pages, as cameras write them: grey BGR at a 257th.
   std::vector<cv::Mat> deep;

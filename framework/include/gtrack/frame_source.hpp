@@ -141,6 +141,7 @@ class GTRACK_API RecordedFrames {
   bool seeks_ = true;
   int seeked_blocks_ = 0;
   int image_bits_ = 16;
+  int stack_pages_ = 0;  // a TIFF stack's pages, once counted
   std::vector<std::uint64_t> prints_;  // per frame of frames_ (a video, once a block has needed them)
 };
 

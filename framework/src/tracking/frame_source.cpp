@@ -412,8 +412,15 @@ std::optional<StackLayout> stack_layout(const std::string& file) {
 
 class StackSource final : public FrameSource {
  public:
-  StackSource(std::string spec, ImageSize expected, FrameRange range, double fps)
+  // `pages`: the stack's page count when already known (a stack read again
+  // a block at a time), which spares walking its directories again.
+  StackSource(std::string spec, ImageSize expected, FrameRange range, double fps, int pages = 0)
       : spec_(std::move(spec)), expected_(expected), filter_(range), range_(range), fps_(fps) {
+    index_ = std::max(0, range.first);
+    if (pages > 0) {
+      count_ = pages;
+      return;
+    }
     std::string said;
     {
       detail::CapturedStderr library;  // libtiff's warnings about private tags (ImageJ's, OME's)
@@ -425,7 +432,6 @@ class StackSource final : public FrameSource {
                        (said.empty() ? std::string(")") : "; the decoder said: " + said + ")"));
     }
     if (!said.empty()) logger().debug("{}: the decoder said: {}", spec_, said);
-    index_ = std::max(0, range.first);
     layout_ = stack_layout(spec_);
   }
 
@@ -617,7 +623,13 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
       seek_failed = true;
     }
   }
-  auto source = open_frame_source(spec_, expected_, range, fps_);
+  std::unique_ptr<FrameSource> source;
+  if (stack_pages_ > 0) {
+    source = std::make_unique<StackSource>(spec_, expected_, range, fps_, stack_pages_);
+  } else {
+    source = open_frame_source(spec_, expected_, range, fps_);
+    if (is_tiff_file(spec_)) stack_pages_ = source->frame_count();
+  }
   source->set_image_bits(image_bits_);
   source->set_quiet();
   auto images = collect(*source);
