@@ -12,6 +12,7 @@
 #include <numeric>
 #include <thread>
 #include <sys/wait.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -764,14 +765,8 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   EXPECT_FALSE(fs::exists(fresh.out_dir / "estimates.csv"));
 }
 
-// The files a config names are kept with it: a resumed run refuses a
-// calibration file that changed since the run began, and goes on once it
-// is restored. The copy given back as a config takes its relative paths
-// from the original's folder, not from the output folder it stands in.
-TEST(Fault, ResumeRefusesAChangedFileTheConfigNames) {
-  const fs::path dir = fresh_dir("resume_files");
-  fs::create_directories(dir / "lab");
-  const std::string camera = R"(%YAML:1.0
+// The camera of kConfig as an OpenCV calibration file.
+const std::string kCamera = R"(%YAML:1.0
 ---
 image_width: 128
 image_height: 128
@@ -786,11 +781,26 @@ distortion_coefficients: !!opencv-matrix
    dt: d
    data: [ 0., 0., 0., 0., 0. ]
 )";
-  std::ofstream(dir / "lab" / "camera.yml") << camera;
+
+// kConfig with its camera read from camera.yml beside it.
+std::string calibrated_config() {
   std::string config = kConfig;
   const std::string keys = "fx = 1600.0\nfy = 1600.0\ncx = 63.5\ncy = 63.5\n";
-  ASSERT_NE(config.find(keys), std::string::npos);
+  EXPECT_NE(config.find(keys), std::string::npos);
   config.replace(config.find(keys), keys.size(), "calibration = \"camera.yml\"\n");
+  return config;
+}
+
+// The files a config names are kept with it: a resumed run refuses a
+// calibration file that changed since the run began, and goes on once it
+// is restored. The copy given back as a config takes its relative paths
+// from the original's folder, not from the output folder it stands in.
+TEST(Fault, ResumeRefusesAChangedFileTheConfigNames) {
+  const fs::path dir = fresh_dir("resume_files");
+  fs::create_directories(dir / "lab");
+  const std::string camera = kCamera;
+  std::ofstream(dir / "lab" / "camera.yml") << camera;
+  const std::string config = calibrated_config();
   std::ofstream(dir / "lab" / "lab.toml") << config;
   const auto load = [](const fs::path& file) {
     TrackRun r{gtrack::load_setup(file, {}), {}};
@@ -843,6 +853,41 @@ distortion_coefficients: !!opencv-matrix
       << copied;
   EXPECT_NE(copied.find("# gtrack track: file [sensor] calibration = " + camera_path + ": "), std::string::npos)
       << copied;
+  // The same folder by another name (a symbolic link) holds the same file.
+  fs::create_directory_symlink(dir / "lab", dir / "lablink");
+  EXPECT_EQ(track_error(load(dir / "lablink" / "lab.toml"), again), "");
+}
+
+// A run's copy keeps its folder whatever the folder's name (a backslash,
+// letters beyond ASCII), and a config read from a pipe is read once.
+TEST(Fault, ARunsCopyKeepsAnyFolderAndAConfigMayBeAPipe) {
+  const fs::path dir = fresh_dir("copy_names");
+  const fs::path lab = dir / "back\\slash caf\xC3\xA9";
+  fs::create_directories(lab);
+  std::ofstream(lab / "camera.yml") << kCamera;
+  std::ofstream(lab / "lab.toml") << calibrated_config();
+  TrackRun r{gtrack::load_setup(lab / "lab.toml", {}), {}};
+  r.config = gtrack::engine_config(r.setup);
+  gtrack::TrackOptions o = folder_run(dir, 2);
+  EXPECT_EQ(track_error(r, o), "");
+  const fs::path kept = o.out_dir / "run_config.toml";
+  const std::string text = read_text(kept);
+  EXPECT_NE(text.find("\\\\slash caf\\xC3\\xA9"), std::string::npos) << text;
+  // Read from the output folder, the copy finds camera.yml in lab.
+  EXPECT_NO_THROW(gtrack::load_setup(kept, {}));
+
+  // A pipe: what a shell's <(...) or /dev/stdin gives.
+  const fs::path fifo = dir / "config.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << text; });
+  std::string error;
+  try {
+    gtrack::load_setup(fifo, {});
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  writer.join();
+  EXPECT_EQ(error, "");
 }
 
 // A plugin whose factory throws: the executable exits non-zero with one line

@@ -111,6 +111,10 @@ ConfigTable::~ConfigTable() = default;
 ConfigTable::ConfigTable(const ConfigTable&) = default;
 ConfigTable& ConfigTable::operator=(const ConfigTable&) = default;
 
+ConfigTable ConfigTable::parse(std::string_view text, std::string source) {
+  return parse(text, std::move(source), std::filesystem::path());
+}
+
 ConfigTable ConfigTable::parse(std::string_view text, std::string source, std::filesystem::path base_folder) {
   auto impl = std::make_shared<Impl>();
   try {
@@ -153,7 +157,7 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source, std::f
   return ConfigTable(impl);
 }
 
-ConfigTable ConfigTable::load_file(const std::string& path, std::filesystem::path base_folder) {
+std::string ConfigTable::file_text(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a folder; expected a TOML config file");
   std::ifstream in(path, std::ios::binary);
@@ -161,8 +165,10 @@ ConfigTable ConfigTable::load_file(const std::string& path, std::filesystem::pat
   std::ostringstream s;
   s << in.rdbuf();
   if (in.bad()) throw ConfigError(path + ": cannot read config file");
-  return parse(s.str(), path, std::move(base_folder));
+  return s.str();
 }
+
+ConfigTable ConfigTable::load_file(const std::string& path) { return parse(file_text(path), path); }
 
 const std::string& ConfigTable::source() const { return impl_->source; }
 const std::string& ConfigTable::path() const { return impl_->path; }

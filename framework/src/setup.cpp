@@ -70,8 +70,9 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
 Setup load_setup(const fs::path& config_file, const SetupOptions& options) {
   // A run's copy of its config takes its relative paths from where the
   // original's were taken.
-  return load_setup(ConfigTable::load_file(config_file.string(),
-                                           detail::run_config_base_folder(config_file).value_or(fs::path())),
+  // (The file is read once: it may be a pipe.)
+  const std::string text = ConfigTable::file_text(config_file.string());
+  return load_setup(ConfigTable::parse(text, config_file.string(), detail::run_config_base_folder(text).value_or(fs::path())),
                     options);
 }
 

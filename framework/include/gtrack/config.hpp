@@ -62,12 +62,15 @@ class GTRACK_API ConfigTable {
   ConfigTable& operator=(const ConfigTable&);
 
   // Parses TOML text; `source` names it in errors (a file path or "<string>").
-  // Relative file paths in it are taken from `base_folder`, when given,
-  // else from the folder of `source`.
-  static ConfigTable parse(std::string_view toml_text, std::string source = "<string>",
-                           std::filesystem::path base_folder = {});
+  static ConfigTable parse(std::string_view toml_text, std::string source = "<string>");
+  // The same; relative file paths in it are taken from `base_folder`
+  // instead of the folder of `source`.
+  static ConfigTable parse(std::string_view toml_text, std::string source, std::filesystem::path base_folder);
   // Reads and parses a file. Throws ConfigError naming the file and line.
-  static ConfigTable load_file(const std::string& path, std::filesystem::path base_folder = {});
+  static ConfigTable load_file(const std::string& path);
+  // A config file's text, read once (a pipe too). Throws ConfigError naming
+  // the file when it is a folder or cannot be read.
+  static std::string file_text(const std::string& path);
 
   bool has(std::string_view key) const;
   // Keys present in this table, in file order.
@@ -88,7 +91,7 @@ class GTRACK_API ConfigTable {
   // in the order asked (a key asked twice is listed once).
   std::vector<NamedFile> named_files() const;
   // Where relative file paths start: the folder given to parse() or
-  // load_file(), else the folder of the source ("" without a source).
+  // its own overload of parse(), else the folder of the source ("" without one).
   std::filesystem::path base_folder() const;
   // A string that must be one of `allowed`; the error lists them.
   std::string choice_or(std::string_view key, std::string fallback,

@@ -3,6 +3,7 @@
 #include "run_config.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -28,10 +29,47 @@ constexpr std::string_view kFileLine = "# gtrack track: file ";
 // paths start at the folder of the file named on the first line.
 constexpr std::string_view kEarlierSecondLine = "# (relative paths in it are taken from";
 
-std::string absolute_text(const fs::path& path) {
+// A path on a header line: absolute, in ASCII, every byte readable back
+// (a backslash doubled; control bytes and bytes above 0x7F as \xNN), so
+// that the copy stays valid UTF-8 whatever the folder's name.
+std::string encoded(const fs::path& path) {
   std::error_code ec;
-  const fs::path p = fs::absolute(path, ec);
-  return shown((ec ? path : p.lexically_normal()).string(), 1 << 12);
+  fs::path p = fs::absolute(path, ec);
+  p = ec ? path : p.lexically_normal();
+  std::string out;
+  for (const char ch : p.string()) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\\') {
+      out += "\\\\";
+    } else if (c < 0x20 || c >= 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
+// The path encoded() wrote; nullopt for text it cannot have written.
+std::optional<fs::path> decoded(std::string_view text) {
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\\') {
+      out += text[i];
+    } else if (i + 1 < text.size() && text[i + 1] == '\\') {
+      out += '\\';
+      ++i;
+    } else if (i + 3 < text.size() && text[i + 1] == 'x' && std::isxdigit(static_cast<unsigned char>(text[i + 2])) &&
+               std::isxdigit(static_cast<unsigned char>(text[i + 3]))) {
+      out += static_cast<char>(std::stoi(std::string(text.substr(i + 2, 2)), nullptr, 16));
+      i += 3;
+    } else {
+      return std::nullopt;
+    }
+  }
+  return fs::path(out);
 }
 
 // "812 bytes, FNV-1a 64 0123456789abcdef", or "missing" / "unreadable".
@@ -59,15 +97,26 @@ std::string fingerprint(const fs::path& path) {
   return buf;
 }
 
-std::vector<std::string> header_lines(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
+// The comment lines a text starts with (at most 10,000), without their line ends.
+std::vector<std::string> header_lines(std::string_view text) {
   std::vector<std::string> lines;
-  std::string line;
-  while (std::getline(in, line) && line.rfind("# ", 0) == 0 && lines.size() < 10000) {
+  size_t at = 0;
+  while (at < text.size() && text.compare(at, 2, "# ") == 0 && lines.size() < 10000) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string line(text.substr(at, end - at));
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    lines.push_back(line);
+    lines.push_back(std::move(line));
+    at = end + 1;
   }
   return lines;
+}
+
+// The header lines of a file (read only as far as they go).
+std::vector<std::string> file_header_lines(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string text, line;
+  while (std::getline(in, line) && line.rfind("# ", 0) == 0 && text.size() < (64u << 20)) text += line + "\n";
+  return header_lines(std::string_view(text));
 }
 
 struct KeptFile {
@@ -76,7 +125,7 @@ struct KeptFile {
 
 std::vector<KeptFile> kept_files(const fs::path& file) {
   std::vector<KeptFile> files;
-  for (const std::string& line : header_lines(file)) {
+  for (const std::string& line : file_header_lines(file)) {
     if (line.rfind(kFileLine, 0) != 0) continue;
     const std::string rest = line.substr(kFileLine.size());
     const size_t eq = rest.find(" = ");
@@ -90,29 +139,32 @@ std::vector<KeptFile> kept_files(const fs::path& file) {
 }  // namespace
 
 bool written_by_a_run(const fs::path& file) {
-  const std::vector<std::string> lines = header_lines(file);
+  const std::vector<std::string> lines = file_header_lines(file);
   return !lines.empty() && lines.front().rfind(kFirstLine, 0) == 0;
 }
 
-std::optional<fs::path> run_config_base_folder(const fs::path& file) {
-  const std::vector<std::string> lines = header_lines(file);
+std::optional<fs::path> run_config_base_folder(std::string_view text) {
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.remove_prefix(3);
+  const std::vector<std::string> lines = header_lines(text);
   if (lines.empty() || lines.front().rfind(kFirstLine, 0) != 0) return std::nullopt;
-  std::string folder;
   for (const std::string& line : lines) {
-    if (line.rfind(kBaseLine, 0) == 0) folder = line.substr(kBaseLine.size());
+    if (line.rfind(kBaseLine, 0) == 0) return decoded(std::string_view(line).substr(kBaseLine.size()));
   }
-  if (folder.empty() && lines.size() > 1 && lines[1].rfind(kEarlierSecondLine, 0) == 0) {
+  // A copy by an earlier release: the folder of the file it was read from
+  // (shown as it was, control bytes escaped: such a name is not taken).
+  if (lines.size() > 1 && lines[1].rfind(kEarlierSecondLine, 0) == 0) {
     const size_t from = lines[0].find(kFromMark);
-    if (from != std::string::npos) folder = fs::path(lines[0].substr(from + kFromMark.size())).parent_path().string();
+    if (from == std::string::npos) return std::nullopt;
+    const std::string file = lines[0].substr(from + kFromMark.size());
+    if (file.empty() || file.front() == '<' || file.find('\\') != std::string::npos) return std::nullopt;
+    return fs::path(file).parent_path();
   }
-  // A name shown with escapes ("\x0A") is not the folder's own.
-  if (folder.empty() || folder.front() == '<' || folder.find('\\') != std::string::npos) return std::nullopt;
-  return fs::path(folder);
+  return std::nullopt;
 }
 
 void write_run_config(const fs::path& file, const ConfigTable& root) {
   std::string from = root.source();
-  if (!from.empty() && from.front() != '<') from = absolute_text(from);
+  from = from.empty() ? std::string("<config>") : from.front() == '<' ? shown(from, 1 << 12, true) : encoded(from);
   // A run's own copy given as the config is copied without its header; a
   // byte-order mark goes, or it would stand inside the new header.
   std::string text = root.toml_text();
@@ -121,12 +173,17 @@ void write_run_config(const fs::path& file, const ConfigTable& root) {
   while (text.rfind(kPrefix, 0) == 0) drop_first_line();
   if (text.rfind(kEarlierSecondLine, 0) == 0) drop_first_line();
 
-  std::string header = std::string(kFirstLine) + std::string(kFromMark) + (from.empty() ? "<config>" : from) + "\n";
-  if (const fs::path base = root.base_folder(); !base.empty()) {
-    header += std::string(kBaseLine) + absolute_text(base) + "\n";
+  // Relative paths in a config without a folder of its own (a path
+  // without one, a string) were taken from the working folder.
+  fs::path base = root.base_folder();
+  if (base.empty()) {
+    std::error_code ec;
+    base = fs::current_path(ec);
   }
+  std::string header = std::string(kFirstLine) + std::string(kFromMark) + from + "\n";
+  header += std::string(kBaseLine) + encoded(base) + "\n";
   for (const NamedFile& f : root.named_files()) {
-    header += std::string(kFileLine) + f.key + " = " + absolute_text(f.path) + ": " + fingerprint(f.path) + "\n";
+    header += std::string(kFileLine) + f.key + " = " + encoded(f.path) + ": " + fingerprint(f.path) + "\n";
   }
   header += std::string(kPrefix) + "--resume checks that this config, and the files it names, are unchanged\n";
   replace_file(file, header + text);
@@ -141,9 +198,10 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
   } catch (const Error& e) {
     throw InputError(std::string(e.what()) + "; cannot resume (this is the interrupted run's config)");
   }
-  const std::string now = root.source().empty() ? std::string("this config") : root.source();
+  const std::string now = root.source().empty() ? std::string("this config") : shown(root.source(), 1 << 12);
+  const std::string copy = shown(file.string(), 1 << 12);
   if (d) {
-    throw InputError(file.string() + ": " + d->key + " was " + d->first + " in the interrupted run, is " +
+    throw InputError(copy + ": " + d->key + " was " + d->first + " in the interrupted run, is " +
                      d->second + " in " + now +
                      "; cannot resume with another config (give the config the run was started with, which this "
                      "file copies and names, or another --out)");
@@ -152,9 +210,12 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
   for (const KeptFile& kept : kept_files(file)) {
     const auto it = std::find_if(current.begin(), current.end(), [&](const NamedFile& f) { return f.key == kept.key; });
     if (it == current.end()) continue;
-    const std::string path = absolute_text(it->path);
-    if (path != kept.path) {
-      throw InputError(file.string() + ": " + kept.key + " was the file " + kept.path +
+    const std::string path = encoded(it->path);
+    // The same file by another name (a symbolic link, a bind mount) is the same.
+    const std::optional<fs::path> kept_path = decoded(kept.path);
+    std::error_code ec;
+    if (path != kept.path && !(kept_path && fs::equivalent(*kept_path, it->path, ec))) {
+      throw InputError(copy + ": " + kept.key + " was the file " + kept.path +
                        " in the interrupted run, is " + path + " with " + now +
                        "; cannot resume with another file (give a config in the first one's folder, or another --out)");
     }

@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string_view>
 
 #include "gtrack/config.hpp"
 
@@ -22,9 +23,9 @@ inline constexpr const char* kRunConfigName = "run_config.toml";
 // under that name is never replaced).
 bool written_by_a_run(const std::filesystem::path& file);
 
-// For a run's copy: the folder its relative paths are taken from.
-// nullopt for any other file, or a copy that names no folder.
-std::optional<std::filesystem::path> run_config_base_folder(const std::filesystem::path& file);
+// For the text of a run's copy: the folder its relative paths are taken
+// from. nullopt for any other text, or a copy that names no folder.
+std::optional<std::filesystem::path> run_config_base_folder(std::string_view text);
 
 // Writes the copy of `root` (a copy given as the config is copied without
 // its header) with the files root.named_files() lists.
