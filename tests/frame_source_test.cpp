@@ -369,6 +369,20 @@ TEST(FrameSource, AStacksLayoutFromImageJOrOmeIsChecked) {
       << slices;
   EXPECT_EQ(slices.find("pages, the file has"), std::string::npos) << slices;
 
+  const fs::path time_first = dir / "time_first.tif";
+  write_described_stack(time_first, 8,
+                        "<OME><Image><Pixels DimensionOrder=\"XYTCZ\"\n SizeC=\"2\" SizeT=\"4\" SizeZ=\"1\">"
+                        "</Pixels></Image></OME>");
+  const std::string order = read_all_logged(time_first, 2);
+  EXPECT_NE(order.find("time_first.tif: OME-TIFF says its pages run through time before channels"), std::string::npos)
+      << order;
+
+  // A plain ImageJ stack (ImageJ calls its unlabelled pages slices) is a
+  // recording: not warned about.
+  const fs::path plain_imagej = dir / "plain_imagej.tif";
+  write_described_stack(plain_imagej, 6, "ImageJ=1.54f\nimages=6\nslices=6\nloop=false\n");
+  EXPECT_EQ(read_all_logged(plain_imagej, 1), "");
+
   // A stack that says nothing of its layout, or says it holds what it
   // holds, is read without a word.
   const fs::path plain = dir / "plain.tif";
@@ -376,4 +390,19 @@ TEST(FrameSource, AStacksLayoutFromImageJOrOmeIsChecked) {
   EXPECT_EQ(read_all_logged(plain, 1), "");
   write_described_stack(plain, 3, "ImageJ=1.54f\nimages=3\nframes=3\n");
   EXPECT_EQ(read_all_logged(plain, 1), "");
+}
+
+// Images of other depths than 8 and 16 bits (float, signed) are refused in
+// one line naming the image, not tracked as black.
+TEST(FrameSource, AFloatImageIsRefusedNamingIt) {
+  const fs::path dir = folder_of("float_images", {});
+  ASSERT_TRUE(cv::imwrite((dir / "f0.tif").string(), cv::Mat(8, 8, CV_32FC1, cv::Scalar(0.7))));
+  auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
+  try {
+    src->next();
+    FAIL() << "a float image was read";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("f0.tif: a 32-bit float image; expected 8 or 16 bits"), std::string::npos)
+        << e.what();
+  }
 }

@@ -55,8 +55,8 @@ class GTRACK_API FrameSource {
   virtual std::string ended_early() const { return {}; }
   // Significant bits of 16-bit images, 8 to 16 (default 16): a 16-bit image
   // is scaled to 8 bits by 255 / (2^bits - 1), values above 2^bits - 1
-  // saturating. The first image whose values use less than a sixteenth of
-  // that range is warned about.
+  // saturating. The first 16-bit image is warned about when its values use
+  // less than a sixteenth of that range.
   void set_image_bits(int bits);
   // Leaves out the warnings about what the input is (a stack's layout, dark
   // 16-bit images): for a source that reads again what another one has
@@ -70,7 +70,7 @@ class GTRACK_API FrameSource {
 
  private:
   int image_bits_ = 16;
-  bool warned_bits_ = false;
+  bool checked_bits_ = false;
   bool quiet_ = false;
 };
 

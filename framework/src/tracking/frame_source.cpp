@@ -2,6 +2,7 @@
 #include "gtrack/frame_source.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -32,29 +33,40 @@ void FrameSource::set_image_bits(int bits) {
 }
 
 cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
-  cv::Mat out;
-  if (image.channels() == 1) cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
-  else if (image.channels() == 4) cv::cvtColor(image, out, cv::COLOR_BGRA2BGR);
-  else out = image;
-  if (out.depth() == CV_8U) return out;
+  if (image.depth() != CV_8U && image.depth() != CV_16U) {
+    const char* depth = image.depth() == CV_32F   ? "32-bit float"
+                        : image.depth() == CV_64F ? "64-bit float"
+                        : image.depth() == CV_8S || image.depth() == CV_16S || image.depth() == CV_32S
+                            ? "signed integer"
+                            : "unsupported";
+    throw InputError(name + ": a " + std::string(depth) +
+                     " image; expected 8 or 16 bits per sample (convert it to 8 or 16 bits first)");
+  }
+  cv::Mat out = image;
   if (out.depth() == CV_16U) {
     const double top = std::ldexp(1.0, image_bits_) - 1.0;
-    if (!warned_bits_ && !quiet_) {
-      // Values that stay under a sixteenth of the range: most likely a
-      // camera of fewer bits than said (12-bit data in 16-bit files).
+    if (!checked_bits_ && !quiet_) {
+      // The first 16-bit image: values that stay under a sixteenth of the
+      // range are most likely a camera of fewer bits than said (12-bit
+      // data in 16-bit files).
+      checked_bits_ = true;
       double max = 0;
       cv::minMaxLoc(out.reshape(1), nullptr, &max);
       if (max > 0 && max < (top + 1) / 16) {
         logger().warn("{}: a 16-bit image whose values reach only {} of {:.0f}, so it is dark at 8 bits; if the "
                       "camera gives fewer bits, say so with [tracker] image_bits (now {})",
                       name, max, top, image_bits_);
-        warned_bits_ = true;
       }
     }
     out.convertTo(out, CV_8U, 255.0 / top);
-    return out;
   }
-  out.convertTo(out, CV_8U);
+  if (out.channels() == 2) {  // grey and alpha
+    cv::Mat grey;
+    cv::extractChannel(out, grey, 0);
+    out = grey;
+  }
+  if (out.channels() == 1) cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
+  else if (out.channels() == 4) cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
   return out;
 }
 
@@ -362,48 +374,63 @@ bool is_tiff_file(const std::string& spec) {
 
 // What a stack's first page says of its layout: ImageJ writes "images=",
 // "channels=", "slices=" and "frames=" lines into its description, OME-TIFF
-// (Micro-Manager, Bio-Formats) an XML whose Pixels element has SizeC, SizeZ
-// and SizeT. Pages run channel by channel, then slice by slice, then time
-// point by time point.
+// (Micro-Manager, Bio-Formats) an XML whose Pixels element has SizeC, SizeZ,
+// SizeT and DimensionOrder.
 struct StackLayout {
-  std::string writer;  // "ImageJ" or "OME-TIFF"
-  long long images = 0, channels = 1, slices = 1;
+  std::string writer;      // "ImageJ" or "OME-TIFF"
+  long long images = 0;    // pages the writer wrote
+  long long channels = 1;  // channels per time point (a page's own samples, RGB, not counted)
+  long long slices = 1;    // z-slices per time point
+  long long times = 1;     // time points
+  bool time_last = true;   // time points follow each other (ImageJ always; OME: DimensionOrder ...T)
 };
 
 std::optional<StackLayout> stack_layout(const std::string& file) {
-  detail::CapturedStderr library;  // libtiff's warnings about private tags
-  TIFF* tif = TIFFOpen(file.c_str(), "r");
-  if (!tif) return std::nullopt;
-  char* text = nullptr;
   std::string description;
-  if (TIFFGetField(tif, TIFFTAG_IMAGEDESCRIPTION, &text) == 1 && text) description = text;
-  TIFFClose(tif);
-  library.take();
-  // The digits after `key` in `text`, 0 when there are none.
+  std::uint16_t samples = 1;
+  {
+    detail::CapturedStderr library;  // libtiff's warnings about private tags
+    TIFF* tif = TIFFOpen(file.c_str(), "r");
+    if (!tif) return std::nullopt;
+    char* text = nullptr;
+    if (TIFFGetField(tif, TIFFTAG_IMAGEDESCRIPTION, &text) == 1 && text) description = text;
+    TIFFGetFieldDefaulted(tif, TIFFTAG_SAMPLESPERPIXEL, &samples);
+    TIFFClose(tif);
+  }
+  // The digits after `key` (which starts a line, or follows white space,
+  // in `text`), 0 when there are none.
   const auto number_after = [](std::string_view text, std::string_view key) -> long long {
-    const size_t at = text.find(key);
-    if (at == std::string_view::npos) return 0;
-    long long v = 0;
-    const char* first = text.data() + at + key.size();
-    const auto [end, ec] = std::from_chars(first, text.data() + text.size(), v);
-    return ec == std::errc() && end != first && v <= 1'000'000'000 ? v : 0;
+    for (size_t at = text.find(key); at != std::string_view::npos; at = text.find(key, at + 1)) {
+      if (at > 0 && !std::isspace(static_cast<unsigned char>(text[at - 1]))) continue;
+      long long v = 0;
+      const char* first = text.data() + at + key.size();
+      const auto [end, ec] = std::from_chars(first, text.data() + text.size(), v);
+      return ec == std::errc() && end != first && v <= 1'000'000'000 ? v : 0;
+    }
+    return 0;
   };
   StackLayout layout;
   if (description.rfind("ImageJ=", 0) == 0) {
+    // A plain stack says only images= and slices=: ImageJ takes unlabelled
+    // pages for z-slices, and they are the recording's frames.
     layout.writer = "ImageJ";
-    const std::string lines = "\n" + description;
-    layout.images = number_after(lines, "\nimages=");
-    layout.channels = std::max(1LL, number_after(lines, "\nchannels="));
-    layout.slices = std::max(1LL, number_after(lines, "\nslices="));
-  } else if (const size_t pixels = description.find("<Pixels "); pixels != std::string::npos &&
-                                                                  description.find("<OME") != std::string::npos) {
+    layout.images = number_after(description, "images=");
+    layout.times = std::max(1LL, number_after(description, "frames="));
+    if (layout.times > 1) {
+      layout.channels = std::max(1LL, number_after(description, "channels="));
+      layout.slices = std::max(1LL, number_after(description, "slices="));
+    }
+  } else if (const size_t pixels = description.find("<Pixels"); pixels != std::string::npos &&
+                                                                 description.find("<OME") != std::string::npos) {
     layout.writer = "OME-TIFF";
     const std::string_view tag = std::string_view(description).substr(pixels, description.find('>', pixels) - pixels);
-    layout.channels = std::max(1LL, number_after(tag, " SizeC=\""));
-    layout.slices = std::max(1LL, number_after(tag, " SizeZ=\""));
-    const double images = static_cast<double>(layout.channels) * static_cast<double>(layout.slices) *
-                          static_cast<double>(std::max(1LL, number_after(tag, " SizeT=\"")));
-    layout.images = static_cast<long long>(std::min(images, 1e15));
+    // SizeC counts samples: an RGB page is 3 of them.
+    layout.channels = std::max(1LL, number_after(tag, "SizeC=\"") / std::max<long long>(1, samples));
+    layout.slices = std::max(1LL, number_after(tag, "SizeZ=\""));
+    layout.times = std::max(1LL, number_after(tag, "SizeT=\""));
+    const size_t order = tag.find("DimensionOrder=\"");
+    layout.time_last = order == std::string_view::npos || tag.substr(order + 16, 5).find('T') == 4;
+    layout.images = layout.channels * layout.slices * std::min(layout.times, 1'000'000LL);
   } else {
     return std::nullopt;
   }
@@ -462,15 +489,23 @@ class StackSource final : public FrameSource {
   // that holds fewer pages than its writer says, are warned about.
   void check_layout(const StackLayout& layout) const {
     const long long per_time = layout.channels * layout.slices;
-    if (per_time > 1 && std::max(1, range_.every) % per_time != 0) {
-      logger().warn("{}: {} says it holds {} channel(s) and {} z-slice(s) per time point, but every page is taken "
-                    "as the next frame; track one channel and slice with --every {} (--frames K: for the K-th "
-                    "page of each time point), or split the stack first",
-                    spec_, layout.writer, layout.channels, layout.slices, per_time);
+    if (per_time > 1 && layout.times > 1) {
+      if (!layout.time_last) {
+        logger().warn("{}: {} says its pages run through time before channels or z-slices ({} channel(s), {} "
+                      "z-slice(s), {} time points), but every page is taken as the next frame; save it with time "
+                      "as the last dimension, or one channel and slice per file",
+                      spec_, layout.writer, layout.channels, layout.slices, layout.times);
+      } else if (std::max(1, range_.every) % per_time != 0) {
+        logger().warn("{}: {} says it holds {} channel(s) and {} z-slice(s) per time point, but every page is "
+                      "taken as the next frame; track one channel and slice with --every {} (--frames K: for the "
+                      "K-th page of each time point), or split the stack first",
+                      spec_, layout.writer, layout.channels, layout.slices, per_time);
+      }
     }
     if (layout.images > count_) {
-      logger().warn("{}: {} says it holds {} pages, the file has {}: a copy cut short, or a recording split over "
-                    "several files; the {} pages there are tracked",
+      logger().warn("{}: {} says it holds {} pages, the file has {}: a copy cut short, a recording split over "
+                    "several files, or an ImageJ stack over 4 GB (whose pages after the first have no TIFF "
+                    "directory; save it as an image sequence); the {} pages there are tracked",
                     spec_, layout.writer, layout.images, count_, count_);
     }
   }
