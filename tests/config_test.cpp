@@ -102,6 +102,9 @@ TEST(Config, MissingFileIsOneLine) {
   EXPECT_NE(e.find("/nonexistent/x.toml"), std::string::npos);
 }
 
+using ConfigTableParse = gtrack::ConfigTable (*)(std::string_view, std::string);
+using ConfigTableLoad = gtrack::ConfigTable (*)(const std::string&);
+
 // file_path() takes a relative path from the config's folder, or from the
 // folder given to parse(), and lists each key it resolved once, by its
 // table, for every table of the document.
@@ -124,6 +127,12 @@ TEST(Config, FilePathsAreResolvedAndListed) {
   const auto moved = gtrack::ConfigTable::parse(text, "/out/run_config.toml", "/lab");
   EXPECT_EQ(moved.table("sensor").file_path("calibration"), std::filesystem::path("/lab/cam/c.yml"));
   EXPECT_EQ(gtrack::ConfigTable::parse(text).file_path("top"), std::filesystem::path("a.txt"));
+  // The signatures plugins built against earlier headers call are still
+  // there (a default argument added to them would change their symbols).
+  ConfigTableParse parse = &gtrack::ConfigTable::parse;
+  ConfigTableLoad load = &gtrack::ConfigTable::load_file;
+  EXPECT_EQ(parse(text, "/lab/lab.toml").base_folder(), std::filesystem::path("/lab"));
+  EXPECT_THROW(load("/nonexistent/lab.toml"), gtrack::ConfigError);
 }
 
 // The first key whose value differs, in file order; comments, the order of

@@ -12,6 +12,7 @@
 #include <numeric>
 #include <thread>
 #include <sys/wait.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -723,6 +724,12 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   const auto [r, o] = stopped_run("resume_config");
   const fs::path kept = o.out_dir / "run_config.toml";
   ASSERT_TRUE(fs::exists(kept));
+  // A config without a folder of its own took its relative paths from the
+  // working folder: the copy says so.
+  EXPECT_NE(read_text(kept).find("# gtrack track: its relative paths start at " +
+                                 fs::current_path().lexically_normal().string() + "\n"),
+            std::string::npos)
+      << read_text(kept);
   EXPECT_NE(read_text(kept).find(kConfig), std::string::npos);
   const fs::path csv = o.out_dir / "estimates.csv";
   const std::string csv_text = read_text(csv);
@@ -880,13 +887,25 @@ TEST(Fault, ARunsCopyKeepsAnyFolderAndAConfigMayBeAPipe) {
   const fs::path fifo = dir / "config.fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   std::thread writer([&] { std::ofstream(fifo) << text; });
+  // Were the pipe opened a second time, that open would wait for a writer
+  // for ever: one comes, after 5 s, and the test fails instead of hanging.
+  std::atomic<bool> read{false};
+  std::thread watchdog([&] {
+    for (int i = 0; i < 50 && !read; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (!read) {
+      const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+      if (fd >= 0) ::close(fd);
+    }
+  });
   std::string error;
   try {
     gtrack::load_setup(fifo, {});
   } catch (const std::exception& e) {
     error = e.what();
   }
+  read = true;
   writer.join();
+  watchdog.join();
   EXPECT_EQ(error, "");
 }
 

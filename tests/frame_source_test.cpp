@@ -298,16 +298,16 @@ namespace {
 
 // A stack of `pages` grey 16x16 pages, the first described by `description`
 // (as ImageJ and OME-TIFF writers describe theirs).
-void write_described_stack(const fs::path& file, int pages, const std::string& description) {
+void write_described_stack(const fs::path& file, int pages, const std::string& description, int samples = 1) {
   TIFF* tif = TIFFOpen(file.c_str(), "w");
   ASSERT_NE(tif, nullptr);
-  std::vector<unsigned char> row(16);
+  std::vector<unsigned char> row(16 * static_cast<size_t>(samples));
   for (int p = 0; p < pages; ++p) {
     TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, 16);
     TIFFSetField(tif, TIFFTAG_IMAGELENGTH, 16);
     TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 8);
-    TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 1);
-    TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+    TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, samples);
+    TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, samples == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
     TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
     TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, 16);
     if (p == 0 && !description.empty()) TIFFSetField(tif, TIFFTAG_IMAGEDESCRIPTION, description.c_str());
@@ -371,11 +371,33 @@ TEST(FrameSource, AStacksLayoutFromImageJOrOmeIsChecked) {
 
   const fs::path time_first = dir / "time_first.tif";
   write_described_stack(time_first, 8,
-                        "<OME><Image><Pixels DimensionOrder=\"XYTCZ\"\n SizeC=\"2\" SizeT=\"4\" SizeZ=\"1\">"
+                        "<OME><Image><Pixels DimensionOrder=\"XYTCZ\"\nSizeC=\"2\"\tSizeT=\"4\" SizeZ=\"1\">"
                         "</Pixels></Image></OME>");
   const std::string order = read_all_logged(time_first, 2);
   EXPECT_NE(order.find("time_first.tif: OME-TIFF says its pages run through time before channels"), std::string::npos)
       << order;
+
+  // Time runs last when what follows it has one element (Z here).
+  const fs::path ctz = dir / "ctz.tif";
+  write_described_stack(ctz, 8,
+                        "<OME><Image><Pixels DimensionOrder=\"XYCTZ\" SizeC=\"2\" SizeT=\"4\" SizeZ=\"1\">"
+                        "</Pixels></Image></OME>");
+  const std::string ctz_said = read_all_logged(ctz, 1);
+  EXPECT_NE(ctz_said.find("ctz.tif: OME-TIFF says it holds 2 channel(s)"), std::string::npos) << ctz_said;
+  EXPECT_EQ(read_all_logged(ctz, 2), "");
+  // RGB pages: SizeC counts their samples, and each page is one frame.
+  const fs::path rgb = dir / "rgb.tif";
+  write_described_stack(rgb, 4,
+                        "<OME><Image><Pixels DimensionOrder=\"XYCZT\" SizeC=\"3\" SizeT=\"4\" SizeZ=\"1\">"
+                        "</Pixels></Image></OME>",
+                        3);
+  EXPECT_EQ(read_all_logged(rgb, 1), "");
+  // Two channels without time points: the slices are the time points.
+  const fs::path two_no_frames = dir / "two_no_frames.tif";
+  write_described_stack(two_no_frames, 6, "ImageJ=1.54f\nimages=6\nchannels=2\nslices=3\nhyperstack=true\n");
+  const std::string no_frames = read_all_logged(two_no_frames, 1);
+  EXPECT_NE(no_frames.find("ImageJ says it holds 2 channel(s) and 1 z-slice(s) per time point"), std::string::npos)
+      << no_frames;
 
   // A plain ImageJ stack (ImageJ calls its unlabelled pages slices) is a
   // recording: not warned about.

@@ -42,7 +42,7 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   s.config_file = root.source();
   s.plugin_paths = options.plugin_paths;
   auto loader = std::make_shared<PluginLoader>(options.plugin_paths);
-  const fs::path base = s.config_file.has_parent_path() ? s.config_file.parent_path() : fs::path(".");
+  const fs::path base = root.base_folder().empty() ? fs::path(".") : root.base_folder();
   for (const auto& p : root.strings_or("plugin_path", {})) {
     fs::path dir(p);
     loader->add_path(dir.is_absolute() ? dir : base / dir);

@@ -43,6 +43,11 @@ cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
                      " image; expected 8 or 16 bits per sample (convert it to 8 or 16 bits first)");
   }
   cv::Mat out = image;
+  if (out.channels() == 2) {  // grey and alpha
+    cv::extractChannel(out, out, 0);
+  } else if (out.channels() == 4) {
+    cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
+  }
   if (out.depth() == CV_16U) {
     const double top = std::ldexp(1.0, image_bits_) - 1.0;
     if (!checked_bits_ && !quiet_) {
@@ -60,13 +65,7 @@ cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
     }
     out.convertTo(out, CV_8U, 255.0 / top);
   }
-  if (out.channels() == 2) {  // grey and alpha
-    cv::Mat grey;
-    cv::extractChannel(out, grey, 0);
-    out = grey;
-  }
   if (out.channels() == 1) cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
-  else if (out.channels() == 4) cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
   return out;
 }
 
@@ -410,16 +409,15 @@ std::optional<StackLayout> stack_layout(const std::string& file) {
     return 0;
   };
   StackLayout layout;
+  std::string order = "XYCZT";  // ImageJ's, and OME's when it says none
   if (description.rfind("ImageJ=", 0) == 0) {
     // A plain stack says only images= and slices=: ImageJ takes unlabelled
     // pages for z-slices, and they are the recording's frames.
     layout.writer = "ImageJ";
     layout.images = number_after(description, "images=");
+    layout.channels = std::max(1LL, number_after(description, "channels="));
+    layout.slices = std::max(1LL, number_after(description, "slices="));
     layout.times = std::max(1LL, number_after(description, "frames="));
-    if (layout.times > 1) {
-      layout.channels = std::max(1LL, number_after(description, "channels="));
-      layout.slices = std::max(1LL, number_after(description, "slices="));
-    }
   } else if (const size_t pixels = description.find("<Pixels"); pixels != std::string::npos &&
                                                                  description.find("<OME") != std::string::npos) {
     layout.writer = "OME-TIFF";
@@ -428,11 +426,28 @@ std::optional<StackLayout> stack_layout(const std::string& file) {
     layout.channels = std::max(1LL, number_after(tag, "SizeC=\"") / std::max<long long>(1, samples));
     layout.slices = std::max(1LL, number_after(tag, "SizeZ=\""));
     layout.times = std::max(1LL, number_after(tag, "SizeT=\""));
-    const size_t order = tag.find("DimensionOrder=\"");
-    layout.time_last = order == std::string_view::npos || tag.substr(order + 16, 5).find('T') == 4;
-    layout.images = layout.channels * layout.slices * std::min(layout.times, 1'000'000LL);
+    if (const size_t at = tag.find("DimensionOrder=\""); at != std::string_view::npos) {
+      order = std::string(tag.substr(at + 16, 5));
+    }
+    const double images = static_cast<double>(layout.channels) * static_cast<double>(layout.slices) *
+                          static_cast<double>(layout.times);
+    layout.images = static_cast<long long>(std::min(images, 1e15));
   } else {
     return std::nullopt;
+  }
+  // Without time points, the slices are taken as the time points: ImageJ
+  // calls the pages of a plain stack slices.
+  char time = 'T';
+  if (layout.times == 1 && layout.slices > 1) {
+    std::swap(layout.times, layout.slices);
+    time = 'Z';
+  }
+  // Time runs last when every dimension after it has one element.
+  const size_t t = order.find(time);
+  for (size_t k = t == std::string::npos ? order.size() : t + 1; k < order.size(); ++k) {
+    if ((order[k] == 'C' && layout.channels > 1) || (order[k] == 'Z' && time == 'T' && layout.slices > 1)) {
+      layout.time_last = false;
+    }
   }
   return layout;
 }

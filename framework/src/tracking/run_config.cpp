@@ -99,6 +99,7 @@ std::string fingerprint(const fs::path& path) {
 
 // The comment lines a text starts with (at most 10,000), without their line ends.
 std::vector<std::string> header_lines(std::string_view text) {
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.remove_prefix(3);  // an editor's byte-order mark
   std::vector<std::string> lines;
   size_t at = 0;
   while (at < text.size() && text.compare(at, 2, "# ") == 0 && lines.size() < 10000) {
@@ -115,7 +116,10 @@ std::vector<std::string> header_lines(std::string_view text) {
 std::vector<std::string> file_header_lines(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::string text, line;
-  while (std::getline(in, line) && line.rfind("# ", 0) == 0 && text.size() < (64u << 20)) text += line + "\n";
+  while (std::getline(in, line) && (line.rfind("# ", 0) == 0 || (text.empty() && line.rfind("\xEF\xBB\xBF# ", 0) == 0)) &&
+         text.size() < (64u << 20)) {
+    text += line + "\n";
+  }
   return header_lines(std::string_view(text));
 }
 
@@ -144,7 +148,6 @@ bool written_by_a_run(const fs::path& file) {
 }
 
 std::optional<fs::path> run_config_base_folder(std::string_view text) {
-  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.remove_prefix(3);
   const std::vector<std::string> lines = header_lines(text);
   if (lines.empty() || lines.front().rfind(kFirstLine, 0) != 0) return std::nullopt;
   for (const std::string& line : lines) {
@@ -214,13 +217,21 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
     // The same file by another name (a symbolic link, a bind mount) is the same.
     const std::optional<fs::path> kept_path = decoded(kept.path);
     std::error_code ec;
+    // (Messages show the paths as the user gave them.)
+    const auto display = [](const fs::path& p) {
+      std::error_code ec;
+      const fs::path a = fs::absolute(p, ec);
+      return shown((ec ? p : a.lexically_normal()).string(), 1 << 12);
+    };
+    const std::string kept_shown = kept_path ? display(*kept_path) : kept.path;
+    const std::string path_shown = display(it->path);
     if (path != kept.path && !(kept_path && fs::equivalent(*kept_path, it->path, ec))) {
-      throw InputError(copy + ": " + kept.key + " was the file " + kept.path +
-                       " in the interrupted run, is " + path + " with " + now +
+      throw InputError(copy + ": " + kept.key + " was the file " + kept_shown +
+                       " in the interrupted run, is " + path_shown + " with " + now +
                        "; cannot resume with another file (give a config in the first one's folder, or another --out)");
     }
     if (const std::string print = fingerprint(it->path); print != kept.fingerprint) {
-      throw InputError(path + ": has changed since the interrupted run began (" + kept.key + ": it was " +
+      throw InputError(path_shown + ": has changed since the interrupted run began (" + kept.key + ": it was " +
                        kept.fingerprint + ", is " + print +
                        "); cannot resume with another file (restore it, or choose another --out)");
     }
