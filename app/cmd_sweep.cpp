@@ -197,6 +197,15 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (c.synth.frames < 2 || c.sequences < 1) throw gtrack::cli::UsageError("--frames >= 2 and --sequences >= 1");
   c.config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
                                 : gtrack::data_dir() / "configs" / gtrack::synth_preset(c.synth.preset).config;
+  {
+    // Each sequence reads the config again: a pipe would be empty the second time.
+    std::error_code ec;
+    if (vm.count("config") && fs::exists(c.config, ec) && !fs::is_regular_file(c.config, ec) &&
+        !fs::is_directory(c.config, ec)) {
+      throw gtrack::cli::UsageError("--config " + c.config.string() +
+                                    ": a pipe; sweep reads its config once per sequence, so give a file");
+    }
+  }
   const auto particles = parse_list(vm["particles"].as<std::string>(), "particles");
   const auto generations = parse_list(vm["generations"].as<std::string>(), "generations");
   const auto sigmas = parse_list(vm["sigmas"].as<std::string>(), "sigmas");

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "gtrack/model.hpp"
 
 namespace fs = std::filesystem;
@@ -607,6 +609,50 @@ TEST(Cli, SweepChecksItsConfigAndFolderFirst) {
   r = gtrack("sweep" + tiny + " --out " + cfg.string() + "/x");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find(cfg.string() + "/x: cannot create the folder"), std::string::npos) << r.output;
+}
+
+// A config that names a file by a relative path (a calibration beside it):
+// the sequence's config names it absolutely, and tracks from there. A
+// config given as a pipe is read once.
+TEST(Cli, SynthKeepsTheConfigsFilesAndReadsAPipeOnce) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_files";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "lab");
+  cv::FileStorage camera((dir / "lab" / "camera.yml").string(), cv::FileStorage::WRITE);
+  camera << "image_width" << 256 << "image_height" << 256;
+  camera << "camera_matrix" << (cv::Mat_<double>(3, 3) << 3200, 0, 127.5, 0, 3200, 127.5, 0, 0, 1);
+  camera << "distortion_coefficients" << cv::Mat::zeros(1, 5, CV_64F);
+  camera.release();
+  std::ofstream(dir / "lab" / "lab.toml")
+      << "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\ncalibration = \"camera.yml\"\n"
+         "[gripper]\nplugin = \"hydrogel_six_finger\"\n[stimulus]\nplugin = \"temperature_hysteresis\"\n";
+  const fs::path seq = dir / "seq";
+  ASSERT_EQ(gtrack("synth --config " + (dir / "lab" / "lab.toml").string() + " --frames 2 --out " + seq.string()).code,
+            0);
+  EXPECT_NE(read_file(seq / "sequence.toml").find("calibration = '" + (dir / "lab" / "camera.yml").string() + "'"),
+            std::string::npos)
+      << read_file(seq / "sequence.toml");
+  const CliRun tracked = gtrack(track_of(seq) + " --frames 0:1 --out " + (dir / "track").string());
+  EXPECT_EQ(tracked.code, 0) << tracked.output;
+
+  // `cat FILE | gtrack synth --config /dev/stdin ...`, given up after 120 s.
+  const fs::path piped = dir / "piped";
+  const auto synth_from_pipe = [&](const fs::path& file) {
+    const std::string cmd = "cat " + file.string() + " | timeout 120 " + std::string(GTRACK_TEST_BINARY_DIR) +
+                            "/bin/gtrack synth --config /dev/stdin --frames 2 --out " + piped.string() + " 2>&1";
+    FILE* p = ::popen(cmd.c_str(), "r");
+    std::string out;
+    std::array<char, 4096> buf;
+    while (p && std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+    const int status = p ? ::pclose(p) : -1;
+    return CliRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  };
+  // (A pipe has no folder of the config's: a relative calibration is not found, in one line.)
+  expect_refusal(synth_from_pipe(dir / "lab" / "lab.toml"), "camera.yml");
+  std::ofstream(dir / "plain.toml") << kConfig << "[stimulus]\nplugin = \"temperature_hysteresis\"\n";
+  const CliRun plain = synth_from_pipe(dir / "plain.toml");
+  EXPECT_EQ(plain.code, 0) << plain.output;
+  EXPECT_TRUE(fs::exists(piped / "sequence.toml"));
 }
 
 }  // namespace

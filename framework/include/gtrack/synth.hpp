@@ -147,12 +147,17 @@ struct SynthSummary {
 GTRACK_API SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& options,
                                                  const std::filesystem::path& out);
 
-// A config for tracking a synthetic sequence: every table of `input_config`
-// (plugin tables as they are, but for relative paths in keys ending in
-// "_file", such as a gripper's model_file, made absolute; plugin_path made
+// A config for tracking a synthetic sequence: every table of `config`
+// (plugin tables as they are, but for relative paths made absolute: those
+// the plugins read through ConfigTable::file_path(), and those in keys
+// ending in "_file", such as a gripper's model_file; plugin_path made
 // absolute, with `plugin_paths`, the folders given on the command line,
 // first) plus the engine settings the sequence needs (its frame rate).
 // Nothing about the truth goes in: the tracker starts from its coarse search.
+GTRACK_API void write_sequence_config(const ConfigTable& config, const SynthPlan& plan,
+                                      const std::filesystem::path& out_file,
+                                      const std::vector<std::filesystem::path>& plugin_paths = {});
+// The same for a config file, read again.
 GTRACK_API void write_sequence_config(const std::filesystem::path& input_config, const SynthPlan& plan,
                                       const std::filesystem::path& out_file,
                                       const std::vector<std::filesystem::path>& plugin_paths = {});

@@ -36,14 +36,20 @@ void absolute_files(toml::table& table, const std::filesystem::path& base) {
 
 void write_sequence_config(const std::filesystem::path& input_config, const SynthPlan& plan,
                            const std::filesystem::path& out_file, const std::vector<std::filesystem::path>& plugin_paths) {
+  write_sequence_config(ConfigTable::load_file(input_config.string()), plan, out_file, plugin_paths);
+}
+
+void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, const std::filesystem::path& out_file,
+                           const std::vector<std::filesystem::path>& plugin_paths) {
   namespace fs = std::filesystem;
+  // The text the setup was read from: a config given as a pipe is not read again.
   toml::table root;
   try {
-    root = toml::parse_file(input_config.string());
+    root = toml::parse(config.toml_text(), config.source());
   } catch (const toml::parse_error& e) {
-    throw ConfigError(input_config.string() + ": " + std::string(e.description()));
+    throw ConfigError(config.source() + ": " + std::string(e.description()));
   }
-  const fs::path base = fs::absolute(input_config).parent_path();
+  const fs::path base = config.base_folder().empty() ? fs::current_path() : fs::absolute(config.base_folder());
   toml::array abs;
   for (const fs::path& dir : plugin_paths) abs.push_back(fs::absolute(dir).lexically_normal().string());
   if (auto* paths = root["plugin_path"].as_array()) {
@@ -58,6 +64,14 @@ void write_sequence_config(const std::filesystem::path& input_config, const Synt
   for (const char* t : {"sensor", "gripper", "stimulus"}) {
     if (auto* table = root[t].as_table()) absolute_files(*table, base);
   }
+  // The files the plugins read, "[table] key" -> "table.key".
+  for (const NamedFile& f : config.named_files()) {
+    std::string dotted = f.key;
+    if (const size_t close = dotted.find("] "); dotted.front() == '[' && close != std::string::npos) {
+      dotted = dotted.substr(1, close - 1) + "." + dotted.substr(close + 2);
+    }
+    if (auto* s = root.at_path(dotted).as_string()) *s = fs::absolute(f.path).lexically_normal().string();
+  }
   if (!root["tracker"].as_table()) root.insert_or_assign("tracker", toml::table{});
   toml::table& tracker = *root["tracker"].as_table();
   tracker.insert_or_assign("fps", plan.preset.frame_rate_hz);
@@ -67,7 +81,11 @@ void write_sequence_config(const std::filesystem::path& input_config, const Synt
   if (!out) throw InputError(out_file.string() + ": cannot write");
   out << "# gtrack: config for tracking the synthetic sequence in this folder.\n"
       << "#   gtrack track --config sequence.toml --input frames --stimulus stimulus.csv --out track\n"
-      << "# Made by 'gtrack synth' from " << fs::absolute(input_config).string() << "\n"
+      << "# Made by 'gtrack synth' from " << shown(config.source().empty() || config.source().front() == '<'
+                                                       ? config.source()
+                                                       : fs::absolute(config.source()).string(),
+                                                   1 << 12)
+      << "\n"
       << "# (preset '" << plan.preset.name << "', seed " << plan.options.seed << ", " << plan.frames.size()
       << " frames";
   if (plan.options.occlusion_scale != 1) out << ", occlusion scale " << plan.options.occlusion_scale;

@@ -97,7 +97,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   }
   if (s.occluded_frames) s.mean_occlusion /= s.occluded_frames;
   s.sequence_config = out / "sequence.toml";
-  write_sequence_config(setup.config_file, plan, s.sequence_config, setup.plugin_paths);
+  write_sequence_config(setup.root, plan, s.sequence_config, setup.plugin_paths);
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return s;
 }
