@@ -647,7 +647,8 @@ TEST(Cli, SynthKeepsTheConfigsFilesAndReadsAPipeOnce) {
     const int status = p ? ::pclose(p) : -1;
     return CliRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
   };
-  // (A pipe has no folder of the config's: a relative calibration is not found, in one line.)
+  // (A pipe's relative paths are taken from the working folder, which has
+  // no camera.yml: one line naming it.)
   expect_refusal(synth_from_pipe(dir / "lab" / "lab.toml"), "camera.yml");
   std::ofstream(dir / "plain.toml") << kConfig << "[stimulus]\nplugin = \"temperature_hysteresis\"\n";
   const CliRun plain = synth_from_pipe(dir / "plain.toml");

@@ -374,7 +374,7 @@ TEST(FrameSource, AStacksLayoutFromImageJOrOmeIsChecked) {
                         "<OME><Image><Pixels DimensionOrder=\"XYTCZ\"\nSizeC=\"2\"\tSizeT=\"4\" SizeZ=\"1\">"
                         "</Pixels></Image></OME>");
   const std::string order = read_all_logged(time_first, 2);
-  EXPECT_NE(order.find("time_first.tif: OME-TIFF says its pages run through time before channels"), std::string::npos)
+  EXPECT_NE(order.find("time_first.tif: OME-TIFF says its pages do not run through time last (2 channel(s)"), std::string::npos)
       << order;
 
   // Time runs last when what follows it has one element (Z here).

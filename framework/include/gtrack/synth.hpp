@@ -157,7 +157,8 @@ GTRACK_API SynthSummary write_synthetic_sequence(const Setup& setup, const Synth
 GTRACK_API void write_sequence_config(const ConfigTable& config, const SynthPlan& plan,
                                       const std::filesystem::path& out_file,
                                       const std::vector<std::filesystem::path>& plugin_paths = {});
-// The same for a config file, read again.
+// The same for a config file, read again: no plugin has read it, so only
+// the relative paths in keys ending in "_file" are made absolute.
 GTRACK_API void write_sequence_config(const std::filesystem::path& input_config, const SynthPlan& plan,
                                       const std::filesystem::path& out_file,
                                       const std::vector<std::filesystem::path>& plugin_paths = {});

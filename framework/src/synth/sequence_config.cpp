@@ -12,7 +12,9 @@
 #include <vector>
 #include <toml++/toml.h>
 
+#include "../tracking/run_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/synth.hpp"
 
 namespace gtrack {
@@ -36,7 +38,11 @@ void absolute_files(toml::table& table, const std::filesystem::path& base) {
 
 void write_sequence_config(const std::filesystem::path& input_config, const SynthPlan& plan,
                            const std::filesystem::path& out_file, const std::vector<std::filesystem::path>& plugin_paths) {
-  write_sequence_config(ConfigTable::load_file(input_config.string()), plan, out_file, plugin_paths);
+  namespace fs = std::filesystem;
+  const std::string text = ConfigTable::file_text(input_config.string());
+  write_sequence_config(
+      ConfigTable::parse(text, input_config.string(), detail::run_config_base_folder(text).value_or(fs::path())),
+      plan, out_file, plugin_paths);
 }
 
 void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, const std::filesystem::path& out_file,
@@ -67,10 +73,16 @@ void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, con
   // The files the plugins read, "[table] key" -> "table.key".
   for (const NamedFile& f : config.named_files()) {
     std::string dotted = f.key;
-    if (const size_t close = dotted.find("] "); dotted.front() == '[' && close != std::string::npos) {
+    if (const size_t close = dotted.find("] "); !dotted.empty() && dotted.front() == '[' && close != std::string::npos) {
       dotted = dotted.substr(1, close - 1) + "." + dotted.substr(close + 2);
     }
-    if (auto* s = root.at_path(dotted).as_string()) *s = fs::absolute(f.path).lexically_normal().string();
+    if (auto* s = root.at_path(dotted).as_string()) {
+      *s = fs::absolute(f.path).lexically_normal().string();
+    } else {
+      logger().warn("{}: {} names a file that sequence.toml keeps as it was (a key that cannot be found by its "
+                    "dotted path); if it is relative, track the sequence from the config's folder",
+                    config.source(), f.key);
+    }
   }
   if (!root["tracker"].as_table()) root.insert_or_assign("tracker", toml::table{});
   toml::table& tracker = *root["tracker"].as_table();

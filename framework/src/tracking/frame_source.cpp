@@ -382,6 +382,7 @@ struct StackLayout {
   long long slices = 1;    // z-slices per time point
   long long times = 1;     // time points
   bool time_last = true;   // time points follow each other (ImageJ always; OME: DimensionOrder ...T)
+  bool slices_are_times = false;  // no time points: the z-slices are taken as the frames
 };
 
 std::optional<StackLayout> stack_layout(const std::string& file) {
@@ -440,6 +441,7 @@ std::optional<StackLayout> stack_layout(const std::string& file) {
   char time = 'T';
   if (layout.times == 1 && layout.slices > 1) {
     std::swap(layout.times, layout.slices);
+    layout.slices_are_times = true;
     time = 'Z';
   }
   // Time runs last when every dimension after it has one element.
@@ -506,10 +508,12 @@ class StackSource final : public FrameSource {
     const long long per_time = layout.channels * layout.slices;
     if (per_time > 1 && layout.times > 1) {
       if (!layout.time_last) {
-        logger().warn("{}: {} says its pages run through time before channels or z-slices ({} channel(s), {} "
-                      "z-slice(s), {} time points), but every page is taken as the next frame; save it with time "
-                      "as the last dimension, or one channel and slice per file",
-                      spec_, layout.writer, layout.channels, layout.slices, layout.times);
+        logger().warn("{}: {} says its pages do not run through {} last ({} channel(s), {} z-slice(s), {} {}), "
+                      "but every page is taken as the next frame; save it with that dimension last, or one channel "
+                      "and slice per file",
+                      spec_, layout.writer, layout.slices_are_times ? "z-slices (taken as frames)" : "time",
+                      layout.channels, layout.slices, layout.times,
+                      layout.slices_are_times ? "z-slices taken as frames" : "time points");
       } else if (std::max(1, range_.every) % per_time != 0) {
         logger().warn("{}: {} says it holds {} channel(s) and {} z-slice(s) per time point, but every page is "
                       "taken as the next frame; track one channel and slice with --every {} (--frames K: for the "
