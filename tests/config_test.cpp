@@ -120,9 +120,9 @@ TEST(Config, FilePathsAreResolvedAndListed) {
   EXPECT_EQ(sensor.file_path("calibration"), std::filesystem::path("/lab/cam/c.yml"));
   const auto files = c.named_files();
   ASSERT_EQ(files.size(), 3u);
-  EXPECT_EQ(files[0].key, "[sensor] calibration");
-  EXPECT_EQ(files[1].key, "[sensor] abs");
-  EXPECT_EQ(files[2].key, "top");
+  EXPECT_EQ(files[0].name(), "[sensor] calibration");
+  EXPECT_EQ(files[1].name(), "[sensor] abs");
+  EXPECT_EQ(files[2].name(), "top");
   EXPECT_EQ(files[2].path, std::filesystem::path("/lab/a.txt"));
   const auto moved = gtrack::ConfigTable::parse(text, "/out/run_config.toml", "/lab");
   EXPECT_EQ(moved.table("sensor").file_path("calibration"), std::filesystem::path("/lab/cam/c.yml"));

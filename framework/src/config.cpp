@@ -395,11 +395,11 @@ std::string ConfigTable::string_or(std::string_view key, std::string fallback) c
 std::filesystem::path ConfigTable::file_path(std::string_view key) const {
   std::filesystem::path file = string(key);
   if (file.is_relative()) file = base_folder() / file;
-  const std::string name = impl_->path.empty() ? std::string(key) : "[" + impl_->path + "] " + std::string(key);
   auto& files = *impl_->files;
-  const auto known = std::find_if(files.begin(), files.end(), [&](const NamedFile& f) { return f.key == name; });
+  const auto known = std::find_if(files.begin(), files.end(),
+                                  [&](const NamedFile& f) { return f.table == impl_->path && f.key == key; });
   if (known == files.end()) {
-    files.push_back({name, file});
+    files.push_back({impl_->path, std::string(key), file});
   } else {
     known->path = file;
   }

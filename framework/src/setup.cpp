@@ -69,14 +69,8 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
 
 Setup load_setup(const fs::path& config_file, const SetupOptions& options) {
   // A run's copy of its config takes its relative paths from where the
-  // original's were taken.
-  // (The file is read once: it may be a pipe, whose relative paths are
-  // taken from the working folder, not from /dev.)
-  const std::string text = ConfigTable::file_text(config_file.string());
-  std::error_code ec;
-  fs::path base = detail::run_config_base_folder(text).value_or(fs::path());
-  if (base.empty() && !fs::is_regular_file(config_file, ec)) base = fs::current_path(ec);
-  return load_setup(ConfigTable::parse(text, config_file.string(), base), options);
+  // original's were taken; a pipe's are taken from the working folder.
+  return load_setup(detail::load_config(config_file), options);
 }
 
 }  // namespace gtrack

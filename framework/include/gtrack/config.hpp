@@ -34,12 +34,17 @@ struct Range {
 
 class ConfigTable;
 
-// A file a config names, as file_path() resolved it: the key ("[table] key")
-// and the path. A run keeps them with its config, so that --resume can
-// tell when one of them has changed.
+// A file a config names, as file_path() resolved it: the table's dotted
+// path ("" at the top level), the key, and the path. A run keeps them with
+// its config, so that --resume can tell when one of them has changed.
 struct NamedFile {
+  std::string table;
   std::string key;
   std::filesystem::path path;
+  // "[table] key", or "key" at the top level, as messages name keys.
+  std::string name() const { return table.empty() ? key : "[" + table + "] " + key; }
+  // "table.key", as a TOML path.
+  std::string dotted() const { return table.empty() ? key : table + "." + key; }
 };
 
 // Where two configs differ: the first key (in file order) whose value is

@@ -131,6 +131,9 @@ class GTRACK_API RecordedFrames {
 
  private:
   std::map<int, cv::Mat> fingerprint_in_order(std::size_t lo, std::size_t hi);
+  // Sets up a source this reader opened: its image bits, and quiet (the
+  // first pass warned).
+  void reading_again(FrameSource& source) const;
 
   std::string spec_;
   ImageSize expected_;

@@ -38,11 +38,7 @@ void absolute_files(toml::table& table, const std::filesystem::path& base) {
 
 void write_sequence_config(const std::filesystem::path& input_config, const SynthPlan& plan,
                            const std::filesystem::path& out_file, const std::vector<std::filesystem::path>& plugin_paths) {
-  namespace fs = std::filesystem;
-  const std::string text = ConfigTable::file_text(input_config.string());
-  write_sequence_config(
-      ConfigTable::parse(text, input_config.string(), detail::run_config_base_folder(text).value_or(fs::path())),
-      plan, out_file, plugin_paths);
+  write_sequence_config(detail::load_config(input_config), plan, out_file, plugin_paths);
 }
 
 void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, const std::filesystem::path& out_file,
@@ -70,18 +66,14 @@ void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, con
   for (const char* t : {"sensor", "gripper", "stimulus"}) {
     if (auto* table = root[t].as_table()) absolute_files(*table, base);
   }
-  // The files the plugins read, "[table] key" -> "table.key".
+  // The files the plugins read.
   for (const NamedFile& f : config.named_files()) {
-    std::string dotted = f.key;
-    if (const size_t close = dotted.find("] "); !dotted.empty() && dotted.front() == '[' && close != std::string::npos) {
-      dotted = dotted.substr(1, close - 1) + "." + dotted.substr(close + 2);
-    }
-    if (auto* s = root.at_path(dotted).as_string()) {
+    if (auto* s = root.at_path(f.dotted()).as_string()) {
       *s = fs::absolute(f.path).lexically_normal().string();
     } else {
       logger().warn("{}: {} names a file that sequence.toml keeps as it was (a key that cannot be found by its "
                     "dotted path); if it is relative, track the sequence from the config's folder",
-                    config.source(), f.key);
+                    config.source(), f.name());
     }
   }
   if (!root["tracker"].as_table()) root.insert_or_assign("tracker", toml::table{});

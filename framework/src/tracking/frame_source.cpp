@@ -87,7 +87,6 @@ std::string lowercase_extension(const fs::path& p) {
   return ext;
 }
 
-
 // Decides which source indices are delivered, for every kind of source.
 class RangeFilter {
  public:
@@ -624,10 +623,14 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
   video_ = !fs::is_directory(spec_, ec) && !is_tiff_file(spec_);
 }
 
+void RecordedFrames::reading_again(FrameSource& source) const {
+  source.set_image_bits(image_bits_);
+  source.set_quiet();
+}
+
 std::map<int, cv::Mat> RecordedFrames::fingerprint_in_order(std::size_t lo, std::size_t hi) {
   auto source = open_video(spec_, expected_, {frames_.front(), frames_.back() + 1, every_}, fps_, false);
-  source->set_image_bits(image_bits_);
-  source->set_quiet();
+  reading_again(*source);
   std::vector<std::uint64_t> prints(frames_.size(), 0);
   std::map<int, cv::Mat> block;
   while (auto f = source->next()) {
@@ -667,8 +670,7 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
       if (first_wrong(images) == hi) return images;
     } else {
       auto source = open_video(spec_, expected_, range, fps_, true);
-      source->set_image_bits(image_bits_);
-      source->set_quiet();
+      reading_again(*source);
       auto images = collect(*source);
       if (first_wrong(images) == hi) {
         if (source->seeked()) ++seeked_blocks_;
@@ -684,8 +686,7 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
     source = open_frame_source(spec_, expected_, range, fps_);
     if (is_tiff_file(spec_)) stack_pages_ = source->frame_count();
   }
-  source->set_image_bits(image_bits_);
-  source->set_quiet();
+  reading_again(*source);
   auto images = collect(*source);
   const std::size_t k = first_wrong(images);
   if (k < hi) {

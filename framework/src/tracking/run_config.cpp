@@ -29,15 +29,22 @@ constexpr std::string_view kFileLine = "# gtrack track: file ";
 // paths start at the folder of the file named on the first line.
 constexpr std::string_view kEarlierSecondLine = "# (relative paths in it are taken from";
 
+// `path` made absolute and normal (as it is when that fails).
+fs::path absolute_normal(const fs::path& path) {
+  std::error_code ec;
+  const fs::path p = fs::absolute(path, ec);
+  return ec ? path : p.lexically_normal();
+}
+
+// A path in a message: absolute, control bytes escaped.
+std::string displayed(const fs::path& path) { return shown(absolute_normal(path).string(), 1 << 12); }
+
 // A path on a header line: absolute, in ASCII, every byte readable back
 // (a backslash doubled; control bytes and bytes above 0x7F as \xNN), so
 // that the copy stays valid UTF-8 whatever the folder's name.
 std::string encoded(const fs::path& path) {
-  std::error_code ec;
-  fs::path p = fs::absolute(path, ec);
-  p = ec ? path : p.lexically_normal();
   std::string out;
-  for (const char ch : p.string()) {
+  for (const char ch : absolute_normal(path).string()) {
     const auto c = static_cast<unsigned char>(ch);
     if (c == '\\') {
       out += "\\\\";
@@ -165,6 +172,14 @@ std::optional<fs::path> run_config_base_folder(std::string_view text) {
   return std::nullopt;
 }
 
+ConfigTable load_config(const fs::path& file) {
+  const std::string text = ConfigTable::file_text(file.string());
+  std::error_code ec;
+  fs::path base = run_config_base_folder(text).value_or(fs::path());
+  if (base.empty() && !fs::is_regular_file(file, ec)) base = fs::current_path(ec);
+  return ConfigTable::parse(text, file.string(), base);
+}
+
 void write_run_config(const fs::path& file, const ConfigTable& root) {
   std::string from = root.source();
   from = from.empty() ? std::string("<config>") : from.front() == '<' ? shown(from, 1 << 12, true) : encoded(from);
@@ -186,7 +201,7 @@ void write_run_config(const fs::path& file, const ConfigTable& root) {
   std::string header = std::string(kFirstLine) + std::string(kFromMark) + from + "\n";
   header += std::string(kBaseLine) + encoded(base) + "\n";
   for (const NamedFile& f : root.named_files()) {
-    header += std::string(kFileLine) + f.key + " = " + encoded(f.path) + ": " + fingerprint(f.path) + "\n";
+    header += std::string(kFileLine) + f.name() + " = " + encoded(f.path) + ": " + fingerprint(f.path) + "\n";
   }
   header += std::string(kPrefix) + "--resume checks that this config, and the files it names, are unchanged\n";
   replace_file(file, header + text);
@@ -211,20 +226,15 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
   }
   const std::vector<NamedFile> current = root.named_files();
   for (const KeptFile& kept : kept_files(file)) {
-    const auto it = std::find_if(current.begin(), current.end(), [&](const NamedFile& f) { return f.key == kept.key; });
+    const auto it = std::find_if(current.begin(), current.end(), [&](const NamedFile& f) { return f.name() == kept.key; });
     if (it == current.end()) continue;
     const std::string path = encoded(it->path);
     // The same file by another name (a symbolic link, a bind mount) is the same.
     const std::optional<fs::path> kept_path = decoded(kept.path);
     std::error_code ec;
     // (Messages show the paths as the user gave them.)
-    const auto display = [](const fs::path& p) {
-      std::error_code ec;
-      const fs::path a = fs::absolute(p, ec);
-      return shown((ec ? p : a.lexically_normal()).string(), 1 << 12);
-    };
-    const std::string kept_shown = kept_path ? display(*kept_path) : kept.path;
-    const std::string path_shown = display(it->path);
+    const std::string kept_shown = kept_path ? displayed(*kept_path) : kept.path;
+    const std::string path_shown = displayed(it->path);
     if (path != kept.path && !(kept_path && fs::equivalent(*kept_path, it->path, ec))) {
       throw InputError(copy + ": " + kept.key + " was the file " + kept_shown +
                        " in the interrupted run, is " + path_shown + " with " + now +

@@ -27,6 +27,11 @@ bool written_by_a_run(const std::filesystem::path& file);
 // from. nullopt for any other text, or a copy that names no folder.
 std::optional<std::filesystem::path> run_config_base_folder(std::string_view text);
 
+// A config file, read once (it may be a pipe). Its relative paths start at
+// the folder a run's copy names, at the working folder for a pipe, else at
+// the file's own folder.
+ConfigTable load_config(const std::filesystem::path& file);
+
 // Writes the copy of `root` (a copy given as the config is copied without
 // its header) with the files root.named_files() lists.
 void write_run_config(const std::filesystem::path& file, const ConfigTable& root);
