@@ -21,7 +21,8 @@ namespace {
 std::atomic<bool> g_stop{false};
 std::atomic<bool> g_reader_gone{false};  // --stream: stdout's reader closed the pipe
 
-// The first Ctrl-C lets the current frame finish and the files close; the
+// The first Ctrl-C (or SIGTERM, or SIGHUP when the terminal or the ssh
+// session closes) lets the current frame finish and the files close; the
 // handler then reverts to the default, so a second one ends the process.
 extern "C" void on_sigint(int) { g_stop.store(true); }
 
@@ -32,6 +33,7 @@ void install_sigint() {
   sa.sa_flags = SA_RESETHAND;
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGHUP, &sa, nullptr);
 }
 
 int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {

@@ -100,6 +100,21 @@ TEST(PluginLoader, FactoryThrowsGivesItsMessage) {
   EXPECT_NE(e.find("could not be created: calibration file missing"), std::string::npos) << e;
 }
 
+TEST(PluginLoader, AnErrorThrownByAPluginsMethodOutlivesItsLastInstance) {
+  // The instance, the last owner of its library, goes while the stack
+  // unwinds; the catch block then reads and destroys an exception whose
+  // code is the plugin's.
+  std::string caught;
+  try {
+    gtrack::PluginLoader loader({kFixtures});
+    auto sensor = loader.make_sensor(table("fixture_throwing_later"));
+    (void)sensor->mm_per_pixel();
+  } catch (const gtrack::Error& e) {
+    caught = e.what();
+  }
+  EXPECT_EQ(caught, "fixture_throwing_later: reading 3 is bad");
+}
+
 TEST(PluginLoader, CannotLoadIsReported) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_loader_test";
   fs::create_directories(dir);

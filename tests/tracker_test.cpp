@@ -412,10 +412,11 @@ TEST(TrackSequence, CancellationKeepsValidFiles) {
   EXPECT_NE(std::find(summary.begin(), summary.end(), "  \"cancelled\": true,"), summary.end());
 }
 
-// SIGINT to a real `gtrack track` process: it finishes the frame, closes the
-// files and exits with 130; every row written is complete.
-TEST(TrackCommand, SigintLeavesCompleteRows) {
-  const fs::path seq = write_sequence("seq_sigint", 40);
+// SIGINT (Ctrl-C) or SIGHUP (the terminal closed) to a real `gtrack track`
+// process: it finishes the frame, closes the files and exits with 130; every
+// row written is complete, and the summary is written.
+static void interrupt_leaves_complete_rows(int signal, const std::string& name) {
+  const fs::path seq = write_sequence(name, 40);
   const fs::path cfg = seq / "config.toml";
   std::ofstream(cfg) << kConfig;
   const fs::path out = seq / "out";
@@ -434,7 +435,7 @@ TEST(TrackCommand, SigintLeavesCompleteRows) {
   while (lines(out / "estimates.csv").size() < 3 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  kill(pid, SIGINT);
+  kill(pid, signal);
   int status = 0;
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
@@ -448,6 +449,9 @@ TEST(TrackCommand, SigintLeavesCompleteRows) {
   for (const auto& j : jsonl) EXPECT_TRUE(j.front() == '{' && j.back() == '}') << j;
   EXPECT_TRUE(fs::exists(out / "summary.json"));
 }
+
+TEST(TrackCommand, SigintLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGINT, "seq_sigint"); }
+TEST(TrackCommand, SighupLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGHUP, "seq_sighup"); }
 
 TEST(TrackSequence, WrongImageSizeNamesFileAndSizes) {
   const fs::path dir = temp_dir("wrong_size");

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -163,6 +164,20 @@ void PluginLoader::rebuild() {
   paths_ = std::move(all);
 }
 
+// A library that made an instance stays loaded until the process exits. An
+// exception thrown by a plugin's method can be of a type whose destructor
+// and vtable are the plugin's own copies (gtrack::Error's are inline): the
+// last instance can go while the stack unwinds, and the catch block that
+// then destroys the exception must still find that code mapped.
+namespace {
+void keep_loaded(const std::shared_ptr<dll::shared_library>& lib, const fs::path& file) {
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<dll::shared_library>> loaded;
+  const std::lock_guard<std::mutex> lock(mutex);
+  loaded.try_emplace(file.string(), lib);
+}
+}  // namespace
+
 PluginRecord PluginLoader::inspect(const fs::path& file) {
   auto lib = open_library(file);
   return check_info(*lib, file);
@@ -265,6 +280,7 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
   // The deleter owns the library: the instance is destroyed while its code
   // is still mapped, and the library goes only after its last instance.
   std::shared_ptr<Interface> instance(raw, [lib](Interface* p) { delete p; });
+  keep_loaded(lib, file);
   table.check_all_used();
   logger().debug("loaded {} plugin '{}' {} from {}", to_string(kind), rec.name, rec.version, file.string());
   return instance;
