@@ -169,6 +169,12 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     throw gtrack::cli::UsageError("no --config given and no " + config.string() +
                                   " next to the truth; the config names the gripper model");
   }
+  gtrack::cli::NamedPaths outputs;
+  for (const char* key : {"json", "per-frame"}) {
+    if (vm.count(key)) outputs.emplace_back(std::string("--") + key, vm[key].as<std::string>());
+  }
+  gtrack::cli::check_outputs_apart(outputs,
+                                   {{"--truth", truth_file}, {"--estimates", estimates_file}, {"config", config}});
   gtrack::SetupOptions so;
   so.plugin_paths = common.plugin_paths;
   so.with_stimulus = false;

@@ -45,6 +45,9 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   const std::string out = vm["out"].as<std::string>();
   check_writable(out, true);
   if (vm.count("obj")) check_writable(vm["obj"].as<std::string>(), false);
+  gtrack::cli::NamedPaths outputs = {{"--out", out}};
+  if (vm.count("obj")) outputs.emplace_back("--obj", vm["obj"].as<std::string>());
+  gtrack::cli::check_outputs_apart(outputs, {{"--config", vm["config"].as<std::string>()}});
 
   const auto& model = setup.model();
   const Eigen::VectorXd h = gtrack::parse_parameter_vector(vm["params"].as<std::string>(), model.dims());

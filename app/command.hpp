@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "gtrack/error.hpp"
@@ -62,6 +63,36 @@ inline void check_output_folder(const std::filesystem::path& file, const std::st
   if (std::filesystem::is_directory(file, ec)) {
     throw gtrack::InputError(file.string() + ": is a folder; expected a file name" +
                              (option.empty() ? std::string() : " (--" + option + ")"));
+  }
+}
+
+// Named paths of a command's inputs or outputs, "--json" and its file.
+using NamedPaths = std::vector<std::pair<std::string, std::filesystem::path>>;
+
+// No output may be one of the command's inputs or another of its outputs
+// (the same file by another name or link included): refused, naming both
+// options, before anything is read or written.
+inline void check_outputs_apart(const NamedPaths& outputs, const NamedPaths& inputs) {
+  const auto same = [](const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ec;
+    if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) {
+      return std::filesystem::equivalent(a, b, ec);
+    }
+    return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
+  };
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [option, file] = outputs[i];
+    for (const auto& [input, in_file] : inputs) {
+      if (same(file, in_file)) {
+        throw UsageError(file.string() + ": is the " + input + " input; " + option + " would overwrite it");
+      }
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (same(file, outputs[j].second)) {
+        throw UsageError(file.string() + ": given to both " + outputs[j].first + " and " + option +
+                         "; expected two files");
+      }
+    }
   }
 }
 

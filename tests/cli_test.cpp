@@ -375,6 +375,33 @@ TEST(Cli, AFrameRangeOutsideTheInputIsAnError) {
 
 // eval reads its tables strictly: what it cannot read is named, with the
 // file and line, instead of being skipped.
+// An output given the name of an input, or of another output, is refused
+// before anything is written: the input is left as it was.
+TEST(Cli, AnOutputIsNeverAnInputNorAnotherOutput) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "outputs_apart";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 4 --out " + dir.string()).code, 0);
+  const fs::path truth = dir / "ground_truth.csv", config = dir / "sequence.toml";
+  const std::string truth_text = read_file(truth), config_text = read_file(config);
+  const std::string eval = "eval -t " + truth.string() + " -e " + truth.string() + " ";
+  CliRun r = gtrack(eval + "--json " + truth.string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find(truth.string() + ": is the --truth input; --json would overwrite it"), std::string::npos)
+      << r.output;
+  // The same file by another name.
+  r = gtrack(eval + "--per-frame " + (dir / "." / "sequence.toml").string());
+  EXPECT_NE(r.output.find("is the config input; --per-frame would overwrite it"), std::string::npos) << r.output;
+  r = gtrack(eval + "--json " + (dir / "e.json").string() + " --per-frame " + (dir / "e.json").string());
+  EXPECT_NE(r.output.find("e.json: given to both --json and --per-frame; expected two files"), std::string::npos)
+      << r.output;
+  r = gtrack("render -c " + config.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + (dir / "m.png").string() +
+             " --obj " + config.string());
+  EXPECT_NE(r.output.find("is the --config input; --obj would overwrite it"), std::string::npos) << r.output;
+  EXPECT_EQ(read_file(truth), truth_text);
+  EXPECT_EQ(read_file(config), config_text);
+  EXPECT_FALSE(fs::exists(dir / "e.json"));
+}
+
 TEST(Cli, EvalRefusesMalformedTables) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_strict";
   fs::remove_all(dir);
