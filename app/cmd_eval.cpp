@@ -263,6 +263,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   if (vm.count("json")) {
     std::ofstream out(vm["json"].as<std::string>());
     out << json;
+    out.flush();  // a full disk shows when the buffer goes out
     if (!out) throw gtrack::InputError(vm["json"].as<std::string>() + ": cannot write");
   }
   if (vm.count("per-frame")) gtrack::write_frame_errors(vm["per-frame"].as<std::string>(), ev);

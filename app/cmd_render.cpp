@@ -20,6 +20,7 @@ void write_obj(const std::string& path, const std::vector<Eigen::Vector3d>& tris
   out << "# gtrack posed gripper mesh, millimetres, world frame\n";
   for (const auto& v : tris) out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
   for (size_t i = 0; i < tris.size(); i += 3) out << "f " << i + 1 << " " << i + 2 << " " << i + 3 << "\n";
+  out.flush();  // a full disk shows when the buffer goes out
   if (!out) throw gtrack::InputError(path + ": write failed");
 }
 

@@ -400,6 +400,12 @@ TEST(Cli, AnOutputIsNeverAnInputNorAnotherOutput) {
   EXPECT_EQ(read_file(truth), truth_text);
   EXPECT_EQ(read_file(config), config_text);
   EXPECT_FALSE(fs::exists(dir / "e.json"));
+  // A full disk: the write that fails when the buffer goes out is an error.
+  if (fs::exists("/dev/full")) {
+    r = gtrack(eval + "--json /dev/full");
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find("/dev/full: cannot write"), std::string::npos) << r.output;
+  }
 }
 
 TEST(Cli, EvalRefusesMalformedTables) {

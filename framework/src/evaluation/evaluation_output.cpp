@@ -95,6 +95,7 @@ void write_frame_errors(const std::filesystem::path& file, const Evaluation& ev)
         << num(e.axis_deg[2]) << "," << num(e.joint_deg) << "," << num(e.endpoint_um) << "," << e.symmetry_k << ","
         << (e.tilt_mirror ? 1 : 0) << "," << (e.tilt_branch ? 1 : 0) << "\n";
   }
+  out.flush();  // a full disk shows when the buffer goes out
   if (!out) throw InputError(file.string() + ": write failed");
 }
 

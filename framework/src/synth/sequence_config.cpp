@@ -94,6 +94,7 @@ void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, con
       << " frames";
   if (plan.options.occlusion_scale != 1) out << ", occlusion scale " << plan.options.occlusion_scale;
   out << "). Holds no ground truth: tracking starts from the coarse search.\n\n" << root << "\n";
+  out.flush();  // a full disk shows when the buffer goes out
   if (!out) throw InputError(out_file.string() + ": write failed");
 }
 

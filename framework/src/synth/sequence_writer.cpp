@@ -67,6 +67,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
     std::ofstream csv(out / "stimulus.csv");
     csv << "frame,value\n";
     for (const auto& f : plan.frames) csv << f.frame << "," << f.stimulus << "\n";
+    csv.flush();  // a full disk shows when the buffer goes out
     if (!csv) throw InputError((out / "stimulus.csv").string() + ": write failed");
   }
   SynthSummary s;
@@ -93,6 +94,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
       if (vis[i].in_view < 0.99) ++s.partly_out_frames;
       if (vis[i].in_view < 0.10) ++s.out_of_view_frames;
     }
+    csv.flush();
     if (!csv) throw InputError((out / "ground_truth.csv").string() + ": write failed");
   }
   if (s.occluded_frames) s.mean_occlusion /= s.occluded_frames;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <sstream>
 
 #include "gtrack/error.hpp"
 #include "gtrack/sequence_io.hpp"
@@ -157,8 +158,7 @@ void ResultWriter::close() {
 }
 
 void write_summary(const fs::path& file, const TrackSummary& s) {
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw InputError(file.string() + ": cannot open for writing");
+  std::ostringstream out;
   const double fps = s.wall_s > 0 ? s.frames / s.wall_s : 0.0;
   out << "{\n"
       << "  \"frames\": " << s.frames << ",\n"
@@ -178,7 +178,9 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
       << "  \"input_ended_early\": " << (s.input_ended_early.empty() ? "null" : json_string(s.input_ended_early))
       << "\n"
       << "}\n";
-  if (!out) throw InputError(file.string() + ": write failed");
+  // Whole or not at all: a full disk is an error, and an earlier summary
+  // stays until the new one is complete.
+  detail::replace_file(file, out.str());
 }
 
 namespace {
