@@ -205,6 +205,13 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
                                " has " + std::to_string(setup.model().fingers()) + " fingers");
     }
   }
+  // The truth given as the estimates would evaluate to no error at all.
+  const auto& ex = estimates.extra_columns;
+  if (std::find(ex.begin(), ex.end(), "in_view") != ex.end() && std::find(ex.begin(), ex.end(), "occluded") != ex.end()) {
+    throw gtrack::InputError(estimates_file.string() +
+                             ":1: has the ground truth's 'in_view' and 'occluded' columns; expected estimates (is "
+                             "the truth given as --estimates?)");
+  }
   // Estimates of frames the truth does not have are not evaluated: said once.
   std::set<int> truth_frames;
   for (const auto& r : truth.rows) truth_frames.insert(r.frame);

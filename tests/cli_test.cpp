@@ -383,7 +383,18 @@ TEST(Cli, AnOutputIsNeverAnInputNorAnotherOutput) {
   ASSERT_EQ(gtrack("synth --frames 2 --seed 4 --out " + dir.string()).code, 0);
   const fs::path truth = dir / "ground_truth.csv", config = dir / "sequence.toml";
   const std::string truth_text = read_file(truth), config_text = read_file(config);
-  const std::string eval = "eval -t " + truth.string() + " -e " + truth.string() + " ";
+  // Estimates: the truth without its three share columns.
+  std::string rows_text;
+  {
+    std::stringstream in(truth_text);
+    for (std::string l; std::getline(in, l);) {
+      for (int k = 0; k < 3; ++k) l.erase(l.rfind(','));
+      rows_text += l + "\n";
+    }
+  }
+  const fs::path estimates = dir / "estimates.csv";
+  std::ofstream(estimates) << rows_text;
+  const std::string eval = "eval -t " + truth.string() + " -e " + estimates.string() + " ";
   CliRun r = gtrack(eval + "--json " + truth.string());
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find(truth.string() + ": is the --truth input; --json would overwrite it"), std::string::npos)
@@ -431,6 +442,14 @@ TEST(Cli, EvalRefusesMalformedTables) {
   r = eval(table("in_view.csv", {rows[0], replaced(rows[1], ",1.0000,", ",abc,"), rows[2]}), truth);
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("in_view.csv:2: expected a number for 'visible', got 'abc'"), std::string::npos)
+      << r.output;
+  r = eval(table("share.csv", {rows[0], rows[1].substr(0, rows[1].rfind(',')) + ",1.5", rows[2]}), truth);
+  EXPECT_NE(r.output.find("share.csv:2: expected a share from 0 to 1 for 'occluded', got '1.5'"), std::string::npos)
+      << r.output;
+  r = eval(truth, truth);
+  EXPECT_NE(r.output.find("ground_truth.csv:1: has the ground truth's 'in_view' and 'occluded' columns; expected "
+                          "estimates"),
+            std::string::npos)
       << r.output;
   r = eval(truth, table("wide.csv", {rows[0], rows[1] + ",7"}));
   EXPECT_NE(r.output.find("wide.csv:2: expected 16 columns, got 17"), std::string::npos) << r.output;

@@ -141,7 +141,12 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
         throw InputError(where + "expected a number for '" + table.extra_columns[e] + "', got '" + shown(cell, 60) +
                          "'");
       }
-      row.extra[table.extra_columns[e]] = v;
+      // The shares of the gripper a ground truth says are seen, in view and hidden.
+      const std::string& name = table.extra_columns[e];
+      if (finite && (name == "visible" || name == "in_view" || name == "occluded") && !(v >= 0 && v <= 1)) {
+        throw InputError(where + "expected a share from 0 to 1 for '" + name + "', got '" + shown(cell, 60) + "'");
+      }
+      row.extra[name] = v;
     }
     const auto [first, fresh] = first_line.emplace(row.frame, line_no);
     if (!fresh) {
