@@ -155,7 +155,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
       throw gtrack::InputError(f.string() + ": is a folder; expected a pose table (" +
                                (f == truth_file ? "ground_truth.csv" : "estimates.csv") + ")");
     }
-    if (!fs::is_regular_file(f)) throw gtrack::InputError(f.string() + ": no such file");
+    if (!fs::exists(f)) throw gtrack::InputError(f.string() + ": no such file");  // a pipe is read
   }
   // Where the results go is checked before anything is computed.
   for (const char* key : {"json", "per-frame"}) {

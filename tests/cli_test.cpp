@@ -419,6 +419,23 @@ TEST(Cli, AnOutputIsNeverAnInputNorAnotherOutput) {
   }
 }
 
+// A config or a pose table that never ends is stopped with one line, not
+// read until memory runs out.
+TEST(Cli, AnEndlessConfigOrTableIsStopped) {
+  CliRun r = gtrack("render -c /dev/zero -p 0,0,100,0,0,0,0,0,0,0,0,0 -o x.png");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("/dev/zero: more than 16 MiB; expected a TOML config file"), std::string::npos) << r.output;
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "endless";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 1 --seed 2 --out " + dir.string()).code, 0);
+  r = gtrack("eval -t /dev/zero -e " + (dir / "ground_truth.csv").string() + " -c " + (dir / "sequence.toml").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("/dev/zero:1: a line of more than 65536 characters"), std::string::npos) << r.output;
+  r = gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out").string() + " --restart-from /dev/zero");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("/dev/zero:1: a line of more than 65536 characters"), std::string::npos) << r.output;
+}
+
 TEST(Cli, EvalRefusesMalformedTables) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_strict";
   fs::remove_all(dir);

@@ -37,6 +37,22 @@ bool parse_number(const std::string& s, double& v) {
   return !s.empty() && ec == std::errc() && end == s.data() + s.size();
 }
 
+// std::getline with a bound: a device or a file that is no table (/dev/zero,
+// a video given by mistake) is one line of error, not all of memory.
+bool table_line(std::istream& in, std::string& line, const std::filesystem::path& file, int line_no) {
+  constexpr std::size_t kMaxLine = 1 << 16;
+  line.clear();
+  for (int c; (c = in.get()) != std::char_traits<char>::eof();) {
+    if (c == '\n') return true;
+    if (line.size() >= kMaxLine) {
+      throw InputError(file.string() + ":" + std::to_string(line_no) +
+                       ": a line of more than 65536 characters; expected a CSV pose table");
+    }
+    line.push_back(static_cast<char>(c));
+  }
+  return !line.empty();
+}
+
 }  // namespace
 
 constexpr double kMaxPoseCell = 1e6;
@@ -49,7 +65,7 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot open");
   std::string line;
-  if (!std::getline(in, line)) throw InputError(file.string() + ":1: empty file, expected a header line");
+  if (!table_line(in, line, file, 1)) throw InputError(file.string() + ":1: empty file, expected a header line");
   if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
   const auto header = split_csv(line);
   std::map<std::string, int> col;
@@ -87,7 +103,7 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
 
   int line_no = 1;
   std::map<int, int> first_line;  // frame -> the line it is on
-  while (std::getline(in, line)) {
+  while (table_line(in, line, file, line_no + 1)) {
     ++line_no;
     if (line.empty() || line == "\r") continue;
     const auto cells = split_csv(line);
