@@ -207,6 +207,22 @@ TEST(Cli, RestartFromTheTruthTracksEachFrameFromThePreviousTruth) {
     const double dx = std::stod(restarted[i][1]) - std::stod(t[1]), dy = std::stod(restarted[i][2]) - std::stod(t[2]);
     EXPECT_LT(std::hypot(dx, dy), 0.06) << "frame " << t[0];
   }
+  // A table of frames 0 to 3 does not reach frames 5 to 8: said, not silently ignored.
+  const fs::path early = write("early_truth.csv", "");
+  {
+    std::ofstream out(early);
+    std::stringstream in(read_file(dir / "ground_truth.csv"));
+    std::string l;
+    for (int i = 0; i < 5 && std::getline(in, l); ++i) out << l << "\n";
+  }
+  r = gtrack(track + (dir / "early").string() + " --restart-from " + early.string() + " --score-truth " +
+             early.string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("early_truth.csv: none of its rows (frames 0 to 3) matched a tracked frame (the last: 8); "
+                          "--restart-from changed nothing"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("--score-truth changed nothing"), std::string::npos) << r.output;
 }
 
 TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {

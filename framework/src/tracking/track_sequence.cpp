@@ -187,6 +187,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const PoseTable table = read_gripper_poses(*options.score_truth, setup, true);
     for (const auto& row : table.rows) reference_rows[row.frame] = row.h;
   }
+  int restarts_used = 0, references_used = 0;
   if (options.stimulus_csv) {
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
   }
@@ -349,7 +350,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
 
     if (!restart_rows.empty()) {
       const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
-      if (row != restart_rows.end()) tracker.set_estimate(row->second);
+      if (row != restart_rows.end()) {
+        tracker.set_estimate(row->second);
+        ++restarts_used;
+      }
     }
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
     if (!warned_grey && (summary.frames == 0 || e.observed_pixels == 0)) {
@@ -360,6 +364,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       // Of the reference's symmetric equivalents, the one nearest the estimate.
       const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis);
       e.reference_terms = tracker.score(reference);
+      ++references_used;
     }
 
     const auto t_write = Clock::now();
@@ -400,6 +405,16 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
   summary.wall_s = seconds_since(start);
   summary.overlay_file = overlay.file();
+  // A table of other frames (renumbered, another sequence's) changes nothing: said.
+  const auto warn_unused = [&](const std::optional<std::filesystem::path>& file, const std::map<int, Eigen::VectorXd>& rows,
+                               int used, const char* option) {
+    if (file && !rows.empty() && used == 0 && summary.frames > 1) {
+      logger().warn("{}: none of its rows (frames {} to {}) matched a tracked frame (the last: {}); {} changed nothing",
+                    file->string(), rows.begin()->first, rows.rbegin()->first, previous_index, option);
+    }
+  };
+  warn_unused(options.restart_from, restart_rows, restarts_used, "--restart-from");
+  warn_unused(options.score_truth, reference_rows, references_used, "--score-truth");
   // Resuming a finished run tracks nothing: its summary stays as it was.
   if (!(resumed && summary.frames == 0)) write_summary(options.out_dir / "summary.json", summary);
   return summary;
