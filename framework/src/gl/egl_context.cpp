@@ -117,12 +117,17 @@ EglContext EglContext::open(const ContextRequest& request) {
 
   std::vector<DisplayCandidate> order;
   if (wanted.empty()) {
-    for (DisplayKind kind : {DisplayKind::nvidia, DisplayKind::hardware, DisplayKind::software}) {
+    // A GPU first (NVIDIA's, then any other), then Mesa's surfaceless
+    // platform (llvmpipe), then a software EGL device.
+    for (DisplayKind kind : {DisplayKind::nvidia, DisplayKind::hardware}) {
       for (const auto& d : devices) {
         if (d.kind == kind) order.push_back(d);
       }
     }
     if (surfaceless_available()) order.push_back(surfaceless_candidate());
+    for (const auto& d : devices) {
+      if (d.kind == DisplayKind::software) order.push_back(d);
+    }
   } else if (lowercase(wanted) == "surfaceless") {
     if (!surfaceless_available()) {
       throw Error("gl backend: no EGL context: EGL_MESA_platform_surfaceless is not offered by this EGL library");
@@ -150,9 +155,11 @@ EglContext EglContext::open(const ContextRequest& request) {
     order.push_back(devices[static_cast<size_t>(index)]);
   }
 
-  bool software = false;
-  for (const auto& c : order) software = software || c.kind == DisplayKind::software || c.kind == DisplayKind::surfaceless;
-  if (software) set_software_threads(request.software_threads);
+  // llvmpipe's thread count is read when its context is made; the
+  // environment is left alone when a GPU comes first.
+  if (!order.empty() && (order.front().kind == DisplayKind::software || order.front().kind == DisplayKind::surfaceless)) {
+    set_software_threads(request.software_threads);
+  }
 
   std::string why;
   EglContext context = try_open(order, why);
@@ -203,8 +210,11 @@ void EglContext::make_current() const {
   if (eglQueryAPI() != EGL_OPENGL_API) eglBindAPI(EGL_OPENGL_API);
   if (eglGetCurrentContext() == context_) return;
   if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
-    throw Error("gl backend: eglMakeCurrent failed with " + egl_error_name(eglGetError()) +
-                " (a renderer is used from one thread at a time)");
+    const EGLint e = eglGetError();
+    throw Error("gl backend: eglMakeCurrent failed with " + egl_error_name(e) +
+                (e == EGL_BAD_ACCESS ? std::string(" (its context stays current on the thread that created the "
+                                                   "renderer: a gl renderer is used from that thread only)")
+                                     : std::string()));
   }
 }
 

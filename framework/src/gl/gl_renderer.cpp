@@ -492,7 +492,9 @@ void GlRenderer::wait_for_fence() {
   if (fence_ == nullptr) return;
   // A batch takes milliseconds; a GPU that has not finished one in a minute
   // has hung or been reset, and waiting longer would hang the run with it.
-  constexpr int kMaxWaitSeconds = 60;
+  // A software renderer is the CPU doing the work: a batch of hundreds of
+  // thousands of hypotheses at full size takes minutes, and it cannot hang.
+  const int kMaxWaitSeconds = context_.software() ? 3600 : 60;
   for (int waited = 0;; ++waited) {
     const GLenum r = gl_.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000ull);
     if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) break;
