@@ -136,6 +136,7 @@ struct SynthSummary {
   double seconds = 0;            // to plan, draw and write
   double duration_s = 0;         // of the sequence, at the preset's frame rate
   double stimulus_low = 0, stimulus_high = 0;  // the profile's range, as planned
+  double stimulus_min = 0, stimulus_max = 0;   // the readings' range over the frames written
   double joint_min_deg = std::numeric_limits<double>::infinity();   // over fingers and frames
   double joint_max_deg = -std::numeric_limits<double>::infinity();
   std::filesystem::path sequence_config;

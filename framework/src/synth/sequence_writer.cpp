@@ -75,6 +75,12 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   s.duration_s = n / plan.preset.frame_rate_hz;
   s.stimulus_low = plan.preset.stimulus_low;
   s.stimulus_high = plan.preset.stimulus_high;
+  if (!plan.frames.empty()) {
+    const auto [lo, hi] = std::minmax_element(plan.frames.begin(), plan.frames.end(),
+                                              [](const auto& a, const auto& b) { return a.stimulus < b.stimulus; });
+    s.stimulus_min = lo->stimulus;
+    s.stimulus_max = hi->stimulus;
+  }
   const int F = setup.model().fingers();
   for (const auto& f : plan.frames) {
     if (F == 0) break;
