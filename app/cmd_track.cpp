@@ -22,8 +22,9 @@ std::atomic<bool> g_stop{false};
 std::atomic<bool> g_reader_gone{false};  // --stream: stdout's reader closed the pipe
 
 // The first Ctrl-C (or SIGTERM, or SIGHUP when the terminal or the ssh
-// session closes) lets the current frame finish and the files close; the
-// handler then reverts to the default, so a second one ends the process.
+// session closes, unless run under `nohup`) lets the current frame finish
+// and the files close; the handler then reverts to the default, so a second
+// one ends the process.
 extern "C" void on_sigint(int) { g_stop.store(true); }
 
 void install_sigint() {
@@ -31,9 +32,12 @@ void install_sigint() {
   sa.sa_handler = on_sigint;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESETHAND;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGHUP, &sa, nullptr);
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
+    // A signal the caller ignores (`nohup`, a background job's SIGINT) stays ignored.
+    struct sigaction old {};
+    if (sigaction(signal, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    sigaction(signal, &sa, nullptr);
+  }
 }
 
 int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {

@@ -70,15 +70,19 @@ inline void check_output_folder(const std::filesystem::path& file, const std::st
 using NamedPaths = std::vector<std::pair<std::string, std::filesystem::path>>;
 
 // No output may be one of the command's inputs or another of its outputs
-// (the same file by another name or link included): refused, naming both
-// options, before anything is read or written.
+// (the same regular file by another name or link included): refused,
+// naming both options, before anything is read or written.
 inline void check_outputs_apart(const NamedPaths& outputs, const NamedPaths& inputs) {
+  // Only a regular file is overwritten: /dev/null or /dev/stdout may be given twice.
   const auto same = [](const std::filesystem::path& a, const std::filesystem::path& b) {
     std::error_code ec;
-    if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) {
-      return std::filesystem::equivalent(a, b, ec);
-    }
-    return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
+    const bool a_there = std::filesystem::exists(a, ec), b_there = std::filesystem::exists(b, ec);
+    if (a_there != b_there) return false;
+    if (a_there) return std::filesystem::is_regular_file(a, ec) && std::filesystem::equivalent(a, b, ec);
+    const auto ca = std::filesystem::weakly_canonical(a, ec);
+    if (ec) return false;
+    const auto cb = std::filesystem::weakly_canonical(b, ec);
+    return !ec && ca == cb;
   };
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const auto& [option, file] = outputs[i];

@@ -218,8 +218,8 @@ TEST(Cli, RestartFromTheTruthTracksEachFrameFromThePreviousTruth) {
   r = gtrack(track + (dir / "early").string() + " --restart-from " + early.string() + " --score-truth " +
              early.string());
   EXPECT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("early_truth.csv: none of its rows (frames 0 to 3) matched a tracked frame (the last: 8); "
-                          "--restart-from changed nothing"),
+  EXPECT_NE(r.output.find("early_truth.csv: none of its rows (frames 0 to 3) is the frame before a tracked one (the "
+                          "last tracked: 8); --restart-from changed nothing"),
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("--score-truth changed nothing"), std::string::npos) << r.output;
@@ -417,13 +417,19 @@ TEST(Cli, AnOutputIsNeverAnInputNorAnotherOutput) {
       << r.output;
   // The same file by another name.
   r = gtrack(eval + "--per-frame " + (dir / "." / "sequence.toml").string());
+  EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("is the config input; --per-frame would overwrite it"), std::string::npos) << r.output;
   r = gtrack(eval + "--json " + (dir / "e.json").string() + " --per-frame " + (dir / "e.json").string());
+  EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("e.json: given to both --json and --per-frame; expected two files"), std::string::npos)
       << r.output;
   r = gtrack("render -c " + config.string() + " -p 0,0,100,0,0,0,0,0,0,0,0,0 -o " + (dir / "m.png").string() +
              " --obj " + config.string());
+  EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("is the --config input; --obj would overwrite it"), std::string::npos) << r.output;
+  // A device is no file to overwrite: /dev/null may take both outputs.
+  r = gtrack(eval + "--json /dev/null --per-frame /dev/null");
+  EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(read_file(truth), truth_text);
   EXPECT_EQ(read_file(config), config_text);
   EXPECT_FALSE(fs::exists(dir / "e.json"));
@@ -480,6 +486,7 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_NE(r.output.find("share.csv:2: expected a share from 0 to 1 for 'occluded', got '1.5'"), std::string::npos)
       << r.output;
   r = eval(truth, truth);
+  EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("ground_truth.csv:1: has the ground truth's 'in_view' and 'occluded' columns; expected "
                           "estimates"),
             std::string::npos)

@@ -415,7 +415,7 @@ TEST(TrackSequence, CancellationKeepsValidFiles) {
 // SIGINT (Ctrl-C) or SIGHUP (the terminal closed) to a real `gtrack track`
 // process: it finishes the frame, closes the files and exits with 130; every
 // row written is complete, and the summary is written.
-static void interrupt_leaves_complete_rows(int signal, const std::string& name) {
+static void interrupt_leaves_complete_rows(int signal, const std::string& name, bool nohup = false) {
   const fs::path seq = write_sequence(name, 40);
   const fs::path cfg = seq / "config.toml";
   std::ofstream(cfg) << kConfig;
@@ -424,6 +424,7 @@ static void interrupt_leaves_complete_rows(int signal, const std::string& name) 
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
+    if (nohup) ::signal(SIGHUP, SIG_IGN);  // as `nohup` starts it
     const std::string input = (seq / "frames").string(), outs = out.string(), cfgs = cfg.string(),
                       stim = (seq / "stimulus.csv").string();
     execl(exe.c_str(), exe.c_str(), "track", "--config", cfgs.c_str(), "--input", input.c_str(), "--stimulus",
@@ -434,6 +435,15 @@ static void interrupt_leaves_complete_rows(int signal, const std::string& name) 
   const auto t0 = std::chrono::steady_clock::now();
   while (lines(out / "estimates.csv").size() < 3 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (nohup) {
+    // Under nohup a closed terminal's SIGHUP changes nothing: the run goes on.
+    kill(pid, SIGHUP);
+    const auto t1 = std::chrono::steady_clock::now();
+    while (lines(out / "estimates.csv").size() < 6 && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(60)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_EQ(waitpid(pid, nullptr, WNOHANG), 0) << "the run stopped on a SIGHUP it was told to ignore";
   }
   kill(pid, signal);
   int status = 0;
@@ -452,6 +462,7 @@ static void interrupt_leaves_complete_rows(int signal, const std::string& name) 
 
 TEST(TrackCommand, SigintLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGINT, "seq_sigint"); }
 TEST(TrackCommand, SighupLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGHUP, "seq_sighup"); }
+TEST(TrackCommand, SighupUnderNohupIsIgnored) { interrupt_leaves_complete_rows(SIGINT, "seq_nohup", true); }
 
 TEST(TrackSequence, WrongImageSizeNamesFileAndSizes) {
   const fs::path dir = temp_dir("wrong_size");

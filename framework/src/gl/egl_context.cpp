@@ -48,8 +48,16 @@ std::string effective_device_request(const std::string& explicit_request) {
   return env ? std::string(env) : std::string();
 }
 
-EglContext EglContext::try_open(const std::vector<DisplayCandidate>& candidates, std::string& why) {
+EglContext EglContext::try_open(const std::vector<DisplayCandidate>& candidates, std::string& why,
+                                int software_threads) {
+  bool threads_set = false;
   for (const DisplayCandidate& c : candidates) {
+    // llvmpipe reads its thread count when its context is made; the
+    // environment is left alone while a GPU is tried.
+    if (!threads_set && (c.kind == DisplayKind::software || c.kind == DisplayKind::surfaceless)) {
+      set_software_threads(software_threads);
+      threads_set = true;
+    }
     std::string reason;
     const EGLDisplay display = acquire_display(c, reason);
     if (display == EGL_NO_DISPLAY) {
@@ -155,14 +163,8 @@ EglContext EglContext::open(const ContextRequest& request) {
     order.push_back(devices[static_cast<size_t>(index)]);
   }
 
-  // llvmpipe's thread count is read when its context is made; the
-  // environment is left alone when a GPU comes first.
-  if (!order.empty() && (order.front().kind == DisplayKind::software || order.front().kind == DisplayKind::surfaceless)) {
-    set_software_threads(request.software_threads);
-  }
-
   std::string why;
-  EglContext context = try_open(order, why);
+  EglContext context = try_open(order, why, request.software_threads);
   if (!context) {
     if (order.empty()) why = "no EGL device and no Mesa surfaceless platform (is an EGL vendor library installed?)";
     throw Error("gl backend: no EGL context with OpenGL 4.5 core could be created: " + why);

@@ -37,8 +37,11 @@ class EglContext {
   // message starts with "gl backend: no EGL context" when none could be made.
   static EglContext open(const ContextRequest& request);
   // Like open() but over the given candidates only; nothing thrown, an empty
-  // context when none works (used to probe for hardware).
-  static EglContext try_open(const std::vector<DisplayCandidate>& candidates, std::string& why);
+  // context when none works (used to probe for hardware). Before the first
+  // software candidate, llvmpipe's thread count is set from
+  // `software_threads` (0: every core) unless LP_NUM_THREADS is set.
+  static EglContext try_open(const std::vector<DisplayCandidate>& candidates, std::string& why,
+                             int software_threads = 0);
 
   EglContext() = default;
   EglContext(EglContext&& other) noexcept;

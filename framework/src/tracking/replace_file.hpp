@@ -32,7 +32,12 @@ inline void replace_file(const std::filesystem::path& file, const std::string& t
     std::ofstream out(tmp, std::ios::trunc | std::ios::binary);
     out << text;
     out.flush();
-    if (!out) throw InputError(tmp.string() + ": write failed");
+    if (!out) {
+      out.close();
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);  // no half-written file is left behind
+      throw InputError(tmp.string() + ": write failed");
+    }
   }
   if (durable) sync_to_disk(tmp);
   std::error_code ec;

@@ -407,14 +407,15 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   summary.overlay_file = overlay.file();
   // A table of other frames (renumbered, another sequence's) changes nothing: said.
   const auto warn_unused = [&](const std::optional<std::filesystem::path>& file, const std::map<int, Eigen::VectorXd>& rows,
-                               int used, const char* option) {
-    if (file && !rows.empty() && used == 0 && summary.frames > 1) {
-      logger().warn("{}: none of its rows (frames {} to {}) matched a tracked frame (the last: {}); {} changed nothing",
-                    file->string(), rows.begin()->first, rows.rbegin()->first, previous_index, option);
+                               int used, const char* option, const char* matched) {
+    if (file && !rows.empty() && used == 0 && summary.frames > 1 && !summary.cancelled) {
+      logger().warn("{}: none of its rows (frames {} to {}) is {} (the last tracked: {}); {} changed nothing",
+                    file->string(), rows.begin()->first, rows.rbegin()->first, matched, previous_index, option);
     }
   };
-  warn_unused(options.restart_from, restart_rows, restarts_used, "--restart-from");
-  warn_unused(options.score_truth, reference_rows, references_used, "--score-truth");
+  // A frame restarts from the row of the frame before it.
+  warn_unused(options.restart_from, restart_rows, restarts_used, "--restart-from", "the frame before a tracked one");
+  warn_unused(options.score_truth, reference_rows, references_used, "--score-truth", "a tracked frame");
   // Resuming a finished run tracks nothing: its summary stays as it was.
   if (!(resumed && summary.frames == 0)) write_summary(options.out_dir / "summary.json", summary);
   return summary;
