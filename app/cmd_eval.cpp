@@ -14,6 +14,7 @@
 #include "command.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
+#include "gtrack/text_file.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
 
@@ -40,8 +41,10 @@ struct FrameScores {
 // is none).
 std::map<int, FrameScores> frame_scores(const fs::path& estimates_csv) {
   std::map<int, FrameScores> out;
-  std::ifstream in(estimates_csv.parent_path() / "estimates.jsonl");
-  for (std::string line; std::getline(in, line);) {
+  const fs::path file = estimates_csv.parent_path() / "estimates.jsonl";
+  std::ifstream in(file);
+  std::string line;
+  for (int n = 1; gtrack::read_bounded_line(in, line, 1 << 16, file.string(), n, "estimates.jsonl's JSON lines"); ++n) {
     const auto field = [&](const std::string& text, const std::string& key) -> std::optional<double> {
       const auto at = text.find("\"" + key + "\":");
       if (at == std::string::npos) return std::nullopt;
@@ -267,12 +270,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
             << " frames lost or off track after them\n";
   if (vm.count("breakdown")) print_breakdown(ev, truth, estimates_file);
   const std::string json = gtrack::evaluation_json(ev);
-  if (vm.count("json")) {
-    std::ofstream out(vm["json"].as<std::string>());
-    out << json;
-    out.flush();  // a full disk shows when the buffer goes out
-    if (!out) throw gtrack::InputError(vm["json"].as<std::string>() + ": cannot write");
-  }
+  if (vm.count("json")) gtrack::write_text_file(vm["json"].as<std::string>(), json);
   if (vm.count("per-frame")) gtrack::write_frame_errors(vm["per-frame"].as<std::string>(), ev);
   return 0;
 }

@@ -1,5 +1,5 @@
 // gtrack render: the model as the sensor sees it, as a mask and a posed mesh.
-#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -9,19 +9,18 @@
 #include "gtrack/log.hpp"
 #include "gtrack/renderer.hpp"
 #include "gtrack/setup.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace po = boost::program_options;
 
 namespace {
 
 void write_obj(const std::string& path, const std::vector<Eigen::Vector3d>& tris) {
-  std::ofstream out(path);
-  if (!out) throw gtrack::InputError(path + ": cannot open for writing");
+  std::ostringstream out;
   out << "# gtrack posed gripper mesh, millimetres, world frame\n";
   for (const auto& v : tris) out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
   for (size_t i = 0; i < tris.size(); i += 3) out << "f " << i + 1 << " " << i + 2 << " " << i + 3 << "\n";
-  out.flush();  // a full disk shows when the buffer goes out
-  if (!out) throw gtrack::InputError(path + ": write failed");
+  gtrack::write_text_file(path, out.str());
 }
 
 // Checked before anything is computed or written: the folder exists, and an

@@ -35,6 +35,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
+#include "gtrack/text_file.hpp"
 #include "gtrack/tracker.hpp"
 
 namespace fs = std::filesystem;
@@ -1004,4 +1005,47 @@ TEST(Fault, NonFiniteParameterVectorIsOneLine) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
     EXPECT_NE(r.output.find("not a finite number"), std::string::npos) << r.output;
   }
+}
+
+// The readers' and writers' shared checks: a line and a file have a bound, a
+// write is checked after its buffer went out.
+TEST(TextFile, BoundsAndFailedWritesAreOneLineErrors) {
+  std::istringstream three("ab\n\nlast");
+  std::string line;
+  std::vector<std::string> got;
+  for (int n = 1; gtrack::read_bounded_line(three, line, 4, "t.csv", n, "rows"); ++n) got.push_back(line);
+  EXPECT_EQ(got, (std::vector<std::string>{"ab", "", "last"}));
+
+  std::istringstream long_line("abcd\nabcde\n");
+  EXPECT_TRUE(gtrack::read_bounded_line(long_line, line, 4, "t.csv", 1, "rows"));
+  try {
+    gtrack::read_bounded_line(long_line, line, 4, "t.csv", 2, "rows");
+    FAIL() << "a line of 5 characters over a bound of 4 must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_STREQ(e.what(), "t.csv:2: a line of more than 4 characters; expected rows");
+  }
+
+  const fs::path dir = fs::temp_directory_path() / "gtrack_text_file_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  gtrack::write_text_file(dir / "a.txt", std::string(3000, 'x'));
+  EXPECT_EQ(gtrack::read_text_file(dir / "a.txt", 3000, "text").size(), 3000u);
+  try {
+    gtrack::read_text_file(dir / "a.txt", 2048, "a small file");
+    FAIL() << "3000 bytes over a bound of 2048 must throw";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "a.txt").string() + ": more than 2 KiB; expected a small file");
+  }
+  EXPECT_THROW(gtrack::read_text_file(dir, 1000, "text"), gtrack::InputError);
+  EXPECT_THROW(gtrack::read_text_file(dir / "none.txt", 1000, "text"), gtrack::InputError);
+  EXPECT_THROW(gtrack::write_text_file(dir / "no_folder" / "a.txt", "x"), gtrack::InputError);
+  if (fs::exists("/dev/full")) {
+    try {
+      gtrack::write_text_file("/dev/full", std::string(1 << 16, 'x'));
+      FAIL() << "a full disk must throw";
+    } catch (const gtrack::InputError& e) {
+      EXPECT_STREQ(e.what(), "/dev/full: write failed");
+    }
+  }
+  fs::remove_all(dir);
 }

@@ -71,7 +71,7 @@ TEST(StimulusLog, ALineWithoutEndAndAFolderAreRefused) {
     StimulusLog::load(file);
     FAIL() << "a 100000-character line must throw";
   } catch (const gtrack::InputError& e) {
-    EXPECT_EQ(std::string(e.what()), file.string() + ":3: a line longer than 4096 characters; expected 'frame,value' "
+    EXPECT_EQ(std::string(e.what()), file.string() + ":3: a line of more than 4096 characters; expected 'frame,value' "
                                                       "or 'time_s,value' rows");
   }
   fs::remove(file);

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
 
 #include "gtrack/error.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -158,23 +158,13 @@ ConfigTable ConfigTable::parse(std::string_view text, std::string source, std::f
 }
 
 std::string ConfigTable::file_text(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a folder; expected a TOML config file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ": cannot open config file (does it exist and is it readable?)");
   // A config is text of a few kilobytes: a device or a pipe that never ends
   // (/dev/zero, a wrong path into a data folder) is stopped, not read into memory.
-  constexpr std::size_t kMaxConfigBytes = std::size_t(16) << 20;
-  std::string text;
-  char buf[1 << 16];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
-    text.append(buf, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxConfigBytes) {
-      throw ConfigError(path + ": more than 16 MiB; expected a TOML config file");
-    }
+  try {
+    return read_text_file(path, std::size_t(16) << 20, "a TOML config file");
+  } catch (const InputError& e) {
+    throw ConfigError(e.what());
   }
-  if (in.bad()) throw ConfigError(path + ": cannot read config file");
-  return text;
 }
 
 ConfigTable ConfigTable::load_file(const std::string& path) { return parse(file_text(path), path); }

@@ -1,11 +1,11 @@
 // The evaluation as JSON and the per-frame errors as CSV.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -78,8 +78,7 @@ std::string evaluation_json(const Evaluation& ev) {
 }
 
 void write_frame_errors(const std::filesystem::path& file, const Evaluation& ev) {
-  std::ofstream out(file);
-  if (!out) throw InputError(file.string() + ": cannot write");
+  std::ostringstream out;
   out << "frame,in_view,out_of_view,status,lost,position_um,inplane_um,depth_um,orientation_deg,rx_err_deg,"
          "ry_err_deg,rz_err_deg,joint_deg,endpoint_um,symmetry_k,tilt_mirror,tilt_branch\n";
   for (const auto& f : ev.per_frame) {
@@ -95,8 +94,7 @@ void write_frame_errors(const std::filesystem::path& file, const Evaluation& ev)
         << num(e.axis_deg[2]) << "," << num(e.joint_deg) << "," << num(e.endpoint_um) << "," << e.symmetry_k << ","
         << (e.tilt_mirror ? 1 : 0) << "," << (e.tilt_branch ? 1 : 0) << "\n";
   }
-  out.flush();  // a full disk shows when the buffer goes out
-  if (!out) throw InputError(file.string() + ": write failed");
+  write_text_file(file, out.str());
 }
 
 }  // namespace gtrack

@@ -10,6 +10,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/parameter_space.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -37,20 +38,10 @@ bool parse_number(const std::string& s, double& v) {
   return !s.empty() && ec == std::errc() && end == s.data() + s.size();
 }
 
-// std::getline with a bound: a device or a file that is no table (/dev/zero,
-// a video given by mistake) is one line of error, not all of memory.
+// A table's line: a device or a file that is no table (/dev/zero, a video
+// given by mistake) is one line of error.
 bool table_line(std::istream& in, std::string& line, const std::filesystem::path& file, int line_no) {
-  constexpr std::size_t kMaxLine = 1 << 16;
-  line.clear();
-  for (int c; (c = in.get()) != std::char_traits<char>::eof();) {
-    if (c == '\n') return true;
-    if (line.size() >= kMaxLine) {
-      throw InputError(file.string() + ":" + std::to_string(line_no) +
-                       ": a line of more than 65536 characters; expected a CSV pose table");
-    }
-    line.push_back(static_cast<char>(c));
-  }
-  return !line.empty();
+  return read_bounded_line(in, line, 1 << 16, file.string(), line_no, "a CSV pose table");
 }
 
 }  // namespace

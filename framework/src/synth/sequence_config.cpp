@@ -8,7 +8,7 @@
 // A configured initial pose is dropped: it described some other scene, and
 // the sequence must be tracked from the coarse search like a new recording.
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <vector>
 #include <toml++/toml.h>
 
@@ -16,6 +16,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/synth.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -81,8 +82,7 @@ void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, con
   tracker.insert_or_assign("fps", plan.preset.frame_rate_hz);
   tracker.erase("initial_pose");
 
-  std::ofstream out(out_file);
-  if (!out) throw InputError(out_file.string() + ": cannot write");
+  std::ostringstream out;
   out << "# gtrack: config for tracking the synthetic sequence in this folder.\n"
       << "#   gtrack track --config sequence.toml --input frames --stimulus stimulus.csv --out track\n"
       << "# Made by 'gtrack synth' from " << shown(config.source().empty() || config.source().front() == '<'
@@ -94,8 +94,7 @@ void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, con
       << " frames";
   if (plan.options.occlusion_scale != 1) out << ", occlusion scale " << plan.options.occlusion_scale;
   out << "). Holds no ground truth: tracking starts from the coarse search.\n\n" << root << "\n";
-  out.flush();  // a full disk shows when the buffer goes out
-  if (!out) throw InputError(out_file.string() + ": write failed");
+  write_text_file(out_file, out.str());
 }
 
 }  // namespace gtrack

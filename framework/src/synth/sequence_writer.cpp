@@ -3,7 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <mutex>
 #include <thread>
@@ -13,6 +13,7 @@
 #include "gtrack/results.hpp"
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/synth.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -64,11 +65,10 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   if (failed) throw Error("synthetic sequence: " + failure);
 
   {
-    std::ofstream csv(out / "stimulus.csv");
+    std::ostringstream csv;
     csv << "frame,value\n";
     for (const auto& f : plan.frames) csv << f.frame << "," << f.stimulus << "\n";
-    csv.flush();  // a full disk shows when the buffer goes out
-    if (!csv) throw InputError((out / "stimulus.csv").string() + ": write failed");
+    write_text_file(out / "stimulus.csv", csv.str());
   }
   SynthSummary s;
   s.frames = n;
@@ -88,7 +88,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
     s.joint_max_deg = std::max(s.joint_max_deg, f.truth.tail(F).maxCoeff());
   }
   {
-    std::ofstream csv(out / "ground_truth.csv");
+    std::ostringstream csv;
     csv << pose_table_header(setup.model().fingers(), {"visible", "in_view", "occluded"}) << "\n";
     for (int i = 0; i < n; ++i) {
       csv << pose_table_row(i, plan.frames[i].truth, {vis[i].visible, vis[i].in_view, vis[i].occluded}) << "\n";
@@ -100,8 +100,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
       if (vis[i].in_view < 0.99) ++s.partly_out_frames;
       if (vis[i].in_view < 0.10) ++s.out_of_view_frames;
     }
-    csv.flush();
-    if (!csv) throw InputError((out / "ground_truth.csv").string() + ": write failed");
+    write_text_file(out / "ground_truth.csv", csv.str());
   }
   if (s.occluded_frames) s.mean_occlusion /= s.occluded_frames;
   s.sequence_config = out / "sequence.toml";

@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "gtrack/error.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack::detail {
 
@@ -28,16 +29,12 @@ inline void sync_to_disk(const std::filesystem::path& path) {
 
 inline void replace_file(const std::filesystem::path& file, const std::string& text, bool durable = false) {
   const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc | std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);  // no half-written file is left behind
-      throw InputError(tmp.string() + ": write failed");
-    }
+  try {
+    write_text_file(tmp, text);
+  } catch (const InputError&) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);  // no half-written file is left behind
+    throw;
   }
   if (durable) sync_to_disk(tmp);
   std::error_code ec;

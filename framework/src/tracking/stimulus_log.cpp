@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "gtrack/error.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -43,22 +44,12 @@ StimulusLog StimulusLog::load(const std::filesystem::path& file) {
   }
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open the stimulus log");
-  // Read a line at a time with a bound, so that a file that never ends a
-  // line (/dev/zero, a binary file) is refused instead of filling memory.
   std::string text, line;
-  int lineno = 0;
-  for (char c; in.get(c);) {
-    line += c;
-    if (c == '\n') {
-      text += line;
-      line.clear();
-      ++lineno;
-    } else if (line.size() > kMaxLine) {
-      throw InputError(file.string() + ":" + std::to_string(lineno + 1) + ": a line longer than " +
-                       std::to_string(kMaxLine) + " characters; expected 'frame,value' or 'time_s,value' rows");
-    }
+  for (int n = 1; read_bounded_line(in, line, kMaxLine, file.string(), n, "'frame,value' or 'time_s,value' rows"); ++n) {
+    text += line;
+    text += '\n';
   }
-  return parse(text + line, file.string());
+  return parse(text, file.string());
 }
 
 StimulusLog StimulusLog::parse(const std::string& text, const std::string& source) {

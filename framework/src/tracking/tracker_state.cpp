@@ -5,14 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <set>
 #include <sstream>
 #include <vector>
 
 #include "gtrack/error.hpp"
+#include "gtrack/text_file.hpp"
 #include "replace_file.hpp"
 
 namespace gtrack {
@@ -150,12 +149,8 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
 }
 
 TrackerState read_tracker_state(const fs::path& file) {
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw InputError(file.string() + ": is a folder; expected a tracker state file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_tracker_state(text, file.string());
+  // A state is a few hundred bytes.
+  return parse_tracker_state(read_text_file(file, 1 << 20, "a tracker state file"), file.string());
 }
 
 }  // namespace gtrack
