@@ -222,6 +222,14 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   for (const auto& r : estimates.rows) {
     if (!truth_frames.count(r.frame)) unmatched.push_back(r.frame);
   }
+  if (!truth_frames.empty() && !unmatched.empty() && unmatched.size() == estimates.rows.size()) {
+    // Not one row in common: another sequence's estimates, or renumbered.
+    throw gtrack::InputError(estimates_file.string() + ": no row is for a frame of " + truth_file.string() +
+                             " (its frames " + std::to_string(estimates.rows.front().frame) + " to " +
+                             std::to_string(estimates.rows.back().frame) + ", the truth's " +
+                             std::to_string(*truth_frames.begin()) + " to " + std::to_string(*truth_frames.rbegin()) +
+                             "); expected the estimates of this sequence");
+  }
   if (!unmatched.empty()) {
     gtrack::logger().warn("{}: {} rows are for frames {} has no row for (the first: frame {}); they are not evaluated",
                           estimates_file.string(), unmatched.size(), truth_file.string(), unmatched.front());

@@ -536,6 +536,26 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_NE(r.output.find("estimates.csv:1: has the tracker's 'status' column; expected a ground truth"),
             std::string::npos)
       << r.output;
+  // Estimates of which no row is for a frame of the truth (renumbered, or
+  // another sequence's): refused, not reported as every frame lost.
+  std::vector<std::string> shifted;
+  {
+    std::ifstream tracked(dir / "tracked" / "estimates.csv");
+    for (std::string l; std::getline(tracked, l);) {
+      shifted.push_back(shifted.empty() ? l : std::to_string(100 + std::stoi(l)) + l.substr(l.find(',')));
+    }
+  }
+  ASSERT_EQ(shifted.size(), 4u);
+  r = eval(truth, table("renumbered.csv", shifted));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("renumbered.csv: no row is for a frame of " + truth.string() +
+                          " (its frames 100 to 102, the truth's 0 to 2)"),
+            std::string::npos)
+      << r.output;
+  shifted[1] = std::to_string(0) + shifted[1].substr(shifted[1].find(','));  // one row in common: evaluated
+  r = eval(truth, table("one_in_common.csv", shifted));
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 rows are for frames"), std::string::npos) << r.output;
 }
 
 // eval --breakdown: every in-view frame with an estimate falls in exactly
