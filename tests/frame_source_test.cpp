@@ -258,6 +258,30 @@ std::string logged(F&& f) {
 
 }  // namespace
 
+// Frames are numbered by their order in a folder: a number missing from
+// the names (a dropped frame) is warned about, once, with the first gap;
+// names that carry time stamps, which never count up by one, are not.
+TEST(FrameSource, AGapInAFoldersNumberingIsWarnedAbout) {
+  const fs::path gap = folder_of("gap", {"img_0001.png", "img_0002.png", "img_0003.png", "img_0005.png",
+                                         "img_0006.png", "img_0009.png"});
+  std::vector<std::string> got;
+  std::string warned = logged([&] {
+    auto src = gtrack::open_frame_source(gap.string(), {4, 4}, {}, 30);
+    got = names(*src);
+  });
+  EXPECT_EQ(got[3], "img_0005.png@3");
+  EXPECT_NE(warned.find("the images' numbers skip from img_0003.png to img_0005.png and at 1 more place;"),
+            std::string::npos)
+      << warned;
+  const fs::path stamped = folder_of("stamped", {"cam_1701234567123.png", "cam_1701234567156.png",
+                                                 "cam_1701234567190.png"});
+  warned = logged([&] { gtrack::open_frame_source(stamped.string(), {4, 4}, {}, 30); });
+  EXPECT_EQ(warned, "");
+  const fs::path whole = folder_of("whole", {"f0.png", "f1.png", "f2.png"});
+  warned = logged([&] { gtrack::open_frame_source(whole.string(), {4, 4}, {}, 30); });
+  EXPECT_EQ(warned, "");
+}
+
 // A 12-bit camera stores its values in the low bits of 16-bit files: at
 // the default 16 bits they come out dark, which is warned about once; with
 // image_bits = 12 they fill the 8 bits, in the first pass and when read again.

@@ -222,6 +222,29 @@ bool natural_less(const std::string& a, const std::string& b) {
   return a < b;
 }
 
+// The last run of digits in a file name and the text around it:
+// "img_0041.png" is {"img_", 41, ".png"}; a name without digits has none.
+struct NameNumber {
+  std::string before, after;
+  long long value = -1;
+};
+NameNumber name_number(const std::string& name) {
+  const size_t end = name.find_last_of("0123456789");
+  if (end == std::string::npos) return {};
+  size_t start = end;
+  while (start > 0 && name[start - 1] >= '0' && name[start - 1] <= '9') --start;
+  if (end + 1 - start > 15) return {};  // not a frame number
+  return {name.substr(0, start), name.substr(end + 1), std::stoll(name.substr(start, end + 1 - start))};
+}
+
+// How image `b`'s number follows image `a`'s: 1 the next number, 0 a gap,
+// -1 no numbering to check (names that differ otherwise, or carry no number).
+int numbered_next(const fs::path& a, const fs::path& b) {
+  const NameNumber x = name_number(a.filename().string()), y = name_number(b.filename().string());
+  if (x.value < 0 || y.value < 0 || x.before != y.before || x.after != y.after) return -1;
+  return y.value == x.value + 1 ? 1 : 0;
+}
+
 class FolderSource final : public FrameSource {
  public:
   FolderSource(const fs::path& dir, ImageSize expected, FrameRange range, double fps, FollowOptions follow)
@@ -287,8 +310,25 @@ class FolderSource final : public FrameSource {
     };
     // Numbers in names compare by value: frame9.png before frame10.png.
     std::sort(found.begin(), found.end(), before);
+    // Frames are numbered by their order here, so a number missing from
+    // the names (a dropped frame) shifts every frame after it: said once per
+    // listing, with the first gap, when most names do count up by one
+    // (names that carry a time stamp do not).
+    int gaps = 0;
+    std::string first_gap;
     for (const auto& f : found) {
-      if (files_.empty() || before(files_.back(), f)) files_.push_back(f);
+      if (!files_.empty() && !before(files_.back(), f)) continue;
+      const int step = files_.empty() ? -1 : numbered_next(files_.back(), f);
+      if (step == 1) ++numbered_steps_;
+      if (step == 0 && gaps++ == 0) first_gap = files_.back().filename().string() + " to " + f.filename().string();
+      files_.push_back(f);
+    }
+    number_gaps_ += gaps;
+    if (gaps > 0 && numbered_steps_ >= number_gaps_) {
+      logger().warn("{}: the images' numbers skip from {}{}; frames are numbered by their order in the folder (0, 1, "
+                    "2, ...), not by their names, so after a gap a frame's number is not the one in its name",
+                    dir_.string(), first_gap,
+                    gaps == 1 ? "" : " and at " + std::to_string(gaps - 1) + (gaps == 2 ? " more place" : " more places"));
     }
   }
 
@@ -352,6 +392,7 @@ class FolderSource final : public FrameSource {
 
   fs::path dir_;
   std::vector<fs::path> files_;
+  int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
   ImageSize expected_;
   RangeFilter filter_;
   double fps_;
