@@ -990,6 +990,11 @@ TEST(Fault, ImplausibleConfigValuesAreRefusedWithFileLineKey) {
       {"tracker", "default_stimulus", "1e300"},
       {"gripper", "folded_deg", "500"},
       {"gripper", "unfolded_deg", "-10"},
+      {"cost", "lambda_dice", "0.0"},  // the image would not count
+      {"render", "scale", "0.05"},     // 6x6 render pixels
+      // A search box beside the field of view (both bounds below each other).
+      {"search", "position_min_mm", "[50.0, 50.0, 90.0]\nposition_max_mm = [60.0, 60.0, 110.0]"},
+      {"search", "position_min_mm", "[-1.0, -1.0, -20.0]\nposition_max_mm = [1.0, 1.0, -10.0]"},  // behind
   });
 }
 

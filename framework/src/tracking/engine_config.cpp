@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "gtrack/error.hpp"
 #include "gtrack/setup.hpp"
@@ -58,7 +59,7 @@ PsoConfig read_pso(const ConfigTable& t) {
 
 CostWeights read_cost(const ConfigTable& t) {
   CostWeights c;
-  c.dice = t.number_or("lambda_dice", c.dice, Range::non_negative());
+  c.dice = t.number_or("lambda_dice", c.dice, Range::positive());  // 0: the image would not count
   c.kinematic = t.number_or("lambda_kinematic", c.kinematic, Range::non_negative());
   c.stimulus = t.number_or("lambda_stimulus", c.stimulus, Range::non_negative());
   c.temporal = t.number_or("lambda_temporal", c.temporal, Range::non_negative());
@@ -76,10 +77,18 @@ CostWeights read_cost(const ConfigTable& t) {
   return c;
 }
 
-RenderOptions read_render(const ConfigTable& t) {
+RenderOptions read_render(const ConfigTable& t, const Sensor& sensor) {
   RenderOptions r;
   r.backend = t.choice_or("backend", r.backend, {"auto", "gl", "cpu"});
   r.scale = t.number_or("scale", r.scale, {0.0, 1.0, true, false});
+  // A render a few pixels across has no shape left to compare.
+  const ImageSize size = sensor.image_size();
+  const long w = std::lround(r.scale * size.width), h = std::lround(r.scale * size.height);
+  if (std::min(w, h) < 8) {
+    t.fail("scale", "renders the " + std::to_string(size.width) + "x" + std::to_string(size.height) + " image at " +
+                        std::to_string(std::max(1L, w)) + "x" + std::to_string(std::max(1L, h)) +
+                        " pixels; expected a scale that keeps at least 8 pixels on each side");
+  }
   r.threads = static_cast<int>(t.integer_or("threads", r.threads, Range::closed(0, 1024)));
   r.egl_device = t.string_or("egl_device", r.egl_device);
   return r;
@@ -88,6 +97,31 @@ RenderOptions read_render(const ConfigTable& t) {
 Eigen::Vector3d vec3(const ConfigTable& t, const char* key, const Eigen::Vector3d& fallback) {
   const auto v = t.numbers_or(key, {fallback.x(), fallback.y(), fallback.z()}, 3);
   return {v[0], v[1], v[2]};
+}
+
+// Whether the box [lo, hi] may hold a point the sensor images: false when all
+// its corners lie outside one of the half-spaces whose intersection is the
+// view (in front of the camera, inside each image border, each clip plane).
+bool box_meets_view(const Projection& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const Eigen::RowVector4d u = p.world_to_image.row(0), v = p.world_to_image.row(1), w = p.world_to_image.row(2);
+  std::vector<Eigen::RowVector4d> halves = {w, u, p.size.width * w - u, v, p.size.height * w - v};
+  for (const auto& c : p.clip_planes) halves.push_back(c.transpose());
+  for (const auto& plane : halves) {
+    bool any_inside = false;
+    for (int corner = 0; corner < 8 && !any_inside; ++corner) {
+      const Eigen::Vector4d x((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
+                              (corner & 4) ? hi.z() : lo.z(), 1.0);
+      any_inside = plane.dot(x) >= 0;
+    }
+    if (!any_inside) return false;
+  }
+  return true;
+}
+
+std::string vec_text(const Eigen::Vector3d& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  return buf;
 }
 
 SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radius) {
@@ -109,6 +143,12 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
   for (int i = 0; i < 3; ++i) {
     if (!(s.position_min_mm[i] < s.position_max_mm[i])) t.fail("position_min_mm", "must be below position_max_mm");
     if (!(s.rotation_min_deg[i] < s.rotation_max_deg[i])) t.fail("rotation_min_deg", "must be below rotation_max_deg");
+  }
+  if (!box_meets_view(sensor.projection(), s.position_min_mm.array() - radius, s.position_max_mm.array() + radius)) {
+    t.fail("position_min_mm", "the box up to position_max_mm lies wholly outside the sensor's view, the model's "
+                              "radius included, so no gripper in it can be seen; expected a box about the field of "
+                              "view, such as the default around " +
+                                  vec_text(sensor.nominal_position_mm()) + " mm");
   }
   return s;
 }
@@ -184,7 +224,7 @@ EngineConfig engine_config(const Setup& setup) {
   }
   {
     const ConfigTable t = root.table("render");
-    e.render = read_render(t);
+    e.render = read_render(t, *setup.sensor);
     t.check_all_used();
   }
   {
