@@ -135,6 +135,84 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   std::string far = kFourFinger;
   far.replace(far.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.2, 500]");
   EXPECT_NE(config_error(far).find("finger[0].base_mm"), std::string::npos) << config_error(far);
+  // Links each within the bound that together reach past it from the palm.
+  std::string reach = kFourFinger;
+  for (size_t at; (at = reach.find("link_lengths_mm = [0.3, 0.3]")) != std::string::npos;) {
+    reach.replace(at, 28, "link_lengths_mm = [60, 60]");
+  }
+  EXPECT_NE(config_error(reach).find("a part is 120.283 mm long or away from the palm centre"), std::string::npos)
+      << config_error(reach);
+}
+
+// symmetry_order is checked against the shape: a quarter turn does not map a
+// two-finger gripper onto itself, nor a rectangle's palm; eval and the
+// tracker's search would otherwise take a turned pose for the same one.
+TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
+  std::string two = kFourFinger;
+  two = two.substr(0, two.find("[[finger]]\nbase_mm = [-0.2, 0.2]")) +
+        two.substr(two.find("[[finger]]\nbase_mm = [-0.2, -0.2]"));
+  two.erase(two.find("[[finger]]\nbase_mm = [0.2, -0.2]"));
+  const std::string e = config_error(two);
+  EXPECT_NE(e.find("<test>:4: key 'symmetry_order': a turn by 90 deg takes finger 1 where no finger of the same "
+                   "shape is"),
+            std::string::npos)
+      << e;
+  std::string two_fold = two;
+  two_fold.replace(two_fold.find("symmetry_order = 4"), 18, "symmetry_order = 2");
+  EXPECT_EQ(config_error(two_fold), "");
+  std::string oblong = kFourFinger;
+  oblong.replace(oblong.find("[[0.4, 0.0], [0.0, 0.4]"), 23, "[[0.6, 0.0], [0.0, 0.4]");
+  EXPECT_NE(config_error(oblong).find("takes palm point 1 [0.6, 0] to [0, 0.6], where the palm has no point"),
+            std::string::npos)
+      << config_error(oblong);
+  std::string longer = kFourFinger;
+  longer.replace(longer.rfind("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 0.4]");
+  EXPECT_NE(config_error(longer).find("key 'symmetry_order'"), std::string::npos) << config_error(longer);
+  // Hand-typed coordinates of a regular shape (three decimals) are the shape.
+  std::string typed = kFourFinger;
+  typed.replace(typed.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.201, 0.199]");
+  EXPECT_EQ(config_error(typed), "");
+}
+
+// Two parallel fingers on each side (a fork): a half turn takes each finger
+// to the one its hinge lands on, not to either finger of the opposite
+// direction, so the turned pose has the same joints in other slots.
+TEST(DataDefinedGripper, AHalfTurnOfAForkMapsFingersByTheirHinges) {
+  auto g = make_gripper(R"(plugin = "data_defined"
+palm_mm = [[0.5, -0.4], [0.5, 0.4], [-0.5, 0.4], [-0.5, -0.4]]
+symmetry_order = 2
+[[finger]]
+base_mm = [0.5, 0.2]
+direction_deg = 0
+link_lengths_mm = [0.5, 0.3]
+link_widths_mm = [0.2, 0.15, 0.1]
+[[finger]]
+base_mm = [0.5, -0.2]
+direction_deg = 0
+link_lengths_mm = [0.5, 0.3]
+link_widths_mm = [0.2, 0.15, 0.1]
+[[finger]]
+base_mm = [-0.5, -0.2]
+direction_deg = 180
+link_lengths_mm = [0.5, 0.3]
+link_widths_mm = [0.2, 0.15, 0.1]
+[[finger]]
+base_mm = [-0.5, 0.2]
+direction_deg = 180
+link_lengths_mm = [0.5, 0.3]
+link_widths_mm = [0.2, 0.15, 0.1]
+)");
+  const auto& m = g->model();
+  Eigen::VectorXd h(10);
+  h << 0, 0, 100, 10, 5, 0, 10, 20, 30, 40;
+  const Eigen::VectorXd e = m.symmetric_equivalent(h, 1);
+  EXPECT_EQ(e.tail(4), (Eigen::Vector4d(30, 40, 10, 20))) << e.transpose();
+  const auto a = m.link_endpoints(h), b = m.link_endpoints(e);
+  for (const auto& p : a) {
+    double best = 1e9;
+    for (const auto& q : b) best = std::min(best, (p - q).norm());
+    EXPECT_LT(best, 1e-9);
+  }
 }
 
 // A model_file that is missing or a folder is named with the key that

@@ -50,6 +50,72 @@ Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg) {
   return t;
 }
 
+std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger_shift) {
+  const int F = static_cast<int>(G.fingers.size());
+  std::vector<int> shift(F);
+  for (int f = 0; f < F; ++f) shift[f] = f;
+  if (finger_shift) *finger_shift = shift;
+  if (G.symmetry_order <= 1) return "";
+  // Positions agree to 2 % of the palm's size (hand-typed coordinates of a
+  // regular shape), directions to 1 degree, links to 2 % of their size.
+  double size = 0;
+  for (const auto& p : G.palm_mm) size = std::max(size, p.norm());
+  for (const auto& f : G.fingers) size = std::max(size, f.base_mm.norm());
+  const double tol = 0.02 * size + 1e-9;
+  const double step = 360.0 / G.symmetry_order;
+  const double c = std::cos(step * kDeg), sn = std::sin(step * kDeg);
+  const auto turned = [&](const Eigen::Vector2d& p) { return Eigen::Vector2d(c * p.x() - sn * p.y(), sn * p.x() + c * p.y()); };
+  const auto angle_apart = [](double a, double b) {
+    const double d = std::fmod(std::abs(a - b), 360.0);
+    return std::min(d, 360.0 - d);
+  };
+  const auto close = [](double a, double b) { return std::abs(a - b) <= 0.02 * std::max(std::abs(a), std::abs(b)) + 1e-6; };
+  const auto same_links = [&](const FingerShape& a, const FingerShape& b) {
+    if (a.links.size() != b.links.size()) return false;
+    for (size_t j = 0; j < a.links.size(); ++j) {
+      if (!close(a.links[j].length_mm, b.links[j].length_mm) || !close(a.links[j].width_start_mm, b.links[j].width_start_mm) ||
+          !close(a.links[j].width_end_mm, b.links[j].width_end_mm)) {
+        return false;
+      }
+    }
+    return true;
+  };
+  char turn[48];
+  std::snprintf(turn, sizeof turn, "a turn by %g deg", step);
+  const std::string head = std::string(turn) + " takes ";
+  const std::string tail = "; expected the number of turns that map the palm and every finger onto themselves (1 for none)";
+  for (size_t i = 0; i < G.palm_mm.size(); ++i) {
+    const Eigen::Vector2d p = turned(G.palm_mm[i]);
+    const bool found = std::any_of(G.palm_mm.begin(), G.palm_mm.end(), [&](const auto& q) { return (q - p).norm() <= tol; });
+    if (!found) {
+      char at[96];
+      const auto shown = [](double v) { return std::abs(v) < 1e-9 ? 0.0 : v; };  // no -0 or 3.7e-17
+      std::snprintf(at, sizeof at, "palm point %zu [%g, %g] to [%.4g, %.4g]", i + 1, G.palm_mm[i].x(),
+                    G.palm_mm[i].y(), shown(p.x()), shown(p.y()));
+      return head + at + ", where the palm has no point" + tail;
+    }
+  }
+  // Finger f lands on finger shift[f]: its hinge, direction and links.
+  std::vector<bool> taken(F, false);
+  for (int f = 0; f < F; ++f) {
+    const FingerShape& a = G.fingers[f];
+    const Eigen::Vector2d base = turned(a.base_mm);
+    int best = -1;
+    for (int g = 0; g < F && best < 0; ++g) {
+      const FingerShape& b = G.fingers[g];
+      if ((b.base_mm - base).norm() <= tol && angle_apart(a.direction_deg + step, b.direction_deg) <= 1.0 && same_links(a, b)) best = g;
+    }
+    if (best < 0 || taken[best]) {
+      return head + "finger " + std::to_string(f + 1) + " where " +
+             (best < 0 ? std::string("no finger of the same shape is") : "finger " + std::to_string(best + 1) + " lands as well") + tail;
+    }
+    taken[best] = true;
+    shift[f] = best;
+  }
+  if (finger_shift) *finger_shift = shift;
+  return "";
+}
+
 ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) {
   const auto& G = geometry_;
   if (G.palm_mm.size() < 3) throw Error("gripper '" + G.name + "': the palm polygon needs at least 3 points");
@@ -74,8 +140,12 @@ ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) 
   double extent = 0;
   for (const auto& F : G.fingers) {
     links += static_cast<int>(F.links.size());
-    extent = std::max(extent, F.base_mm.norm());
-    for (const auto& l : F.links) extent = std::max({extent, l.length_mm, l.width_start_mm, l.width_end_mm});
+    double reach = F.base_mm.norm();  // to the fingertip, stretched out
+    for (const auto& l : F.links) {
+      reach += l.length_mm;
+      extent = std::max({extent, l.width_start_mm, l.width_end_mm});
+    }
+    extent = std::max(extent, reach);
   }
   for (const auto& p : G.palm_mm) extent = std::max(extent, p.norm());
   if (links > kMaxLinks) {
@@ -112,23 +182,9 @@ ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) 
     }
   }
 
-  // One symmetry step rotates by 360/order: finger f lands where finger
-  // shift[f] was. Found by matching base directions.
-  finger_shift_.resize(fingers());
-  const double step = 360.0 / G.symmetry_order;
-  for (int f = 0; f < fingers(); ++f) {
-    const double target = G.fingers[f].direction_deg + step;
-    int best = f;
-    double best_d = 1e9;
-    for (int g2 = 0; g2 < fingers(); ++g2) {
-      double d = std::fmod(std::abs(G.fingers[g2].direction_deg - target), 360.0);
-      d = std::min(d, 360.0 - d);
-      if (d < best_d) {
-        best_d = d;
-        best = g2;
-      }
-    }
-    finger_shift_[f] = best;
+  const std::string broken = symmetry_mismatch(G, &finger_shift_);
+  if (!broken.empty()) {
+    throw Error("gripper '" + G.name + "': symmetry order " + std::to_string(G.symmetry_order) + " does not hold: " + broken);
   }
 }
 

@@ -114,6 +114,12 @@ class GTRACK_API ArticulatedModel {
   std::vector<int> finger_shift_;  // finger permutation for one symmetry step
 };
 
+// Why a geometry's symmetry_order does not hold ("" when it does): a turn
+// by 360/order must take every palm point onto a palm point and every finger
+// onto a finger of the same links, at its hinge and in its direction.
+// `finger_shift`, when given, receives where one turn takes each finger.
+GTRACK_API std::string symmetry_mismatch(const GripperGeometry& geometry, std::vector<int>* finger_shift = nullptr);
+
 // Each finger with the next, around the palm (one pair for two fingers).
 GTRACK_API std::vector<std::pair<int, int>> ring_adjacency(int fingers);
 

@@ -100,6 +100,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   // Default: what the geometry has already; a radial gripper is symmetric
   // under a turn by one finger, one drawn finger by finger is not.
   g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", g.symmetry_order, Range{1, 64}));
+  if (const std::string broken = gtrack::symmetry_mismatch(g); !broken.empty()) t.fail("symmetry_order", broken);
   // Both are joint values the tracker starts from: within the limits.
   const Range limits = Range::closed(g.joint_min_deg, g.joint_max_deg);
   g.unfolded_deg = t.number_or("unfolded_deg", std::clamp(0.0, g.joint_min_deg, g.joint_max_deg), limits);
