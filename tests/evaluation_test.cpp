@@ -153,6 +153,38 @@ TEST(Evaluation, FlagsTheTiltMirrorOfAFlatGripperAndTheOtherTiltBranch) {
   EXPECT_NE(json.find("\"tilt_branch\": {\"frames\": 3"), std::string::npos);
 }
 
+// Depth is along the sensor's viewing axis and in-plane across it, whatever
+// the sensor's orientation: a camera looking down world z splits a position
+// error into z and x-y; an ultrasound slice turned to image world x and z
+// has its depth (across the slice) along world y.
+TEST(Evaluation, DepthIsAlongTheSensorsViewingAxis) {
+  gtrack::Projection pinhole;
+  pinhole.world_to_image << 1000, 0, 500, 0, 0, 1000, 500, 0, 0, 0, 1, 0;
+  EXPECT_LT((gtrack::viewing_axis(pinhole) - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+  gtrack::Projection slice;
+  slice.world_to_image << 10, 0, 0, 5, 0, 0, 10, 7, 0, 0, 0, 1;  // images x and z: the plane y = const
+  const Eigen::Vector3d axis = gtrack::viewing_axis(slice);
+  EXPECT_NEAR(std::abs(axis.y()), 1, 1e-12);
+
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  Eigen::VectorXd truth = Eigen::VectorXd::Zero(m.dims());
+  truth[2] = 30;
+  Eigen::VectorXd across = truth, within = truth;
+  across[1] += 0.2;   // 200 um across the slice
+  within[2] += 0.2;   // 200 um down the image
+  const auto a = gtrack::compare_to_truth(m, truth, across, axis, axis);
+  EXPECT_NEAR(a.depth_um, 200, 1e-6);
+  EXPECT_NEAR(a.inplane_um, 0, 1e-6);
+  const auto w = gtrack::compare_to_truth(m, truth, within, axis, axis);
+  EXPECT_NEAR(w.depth_um, 0, 1e-6);
+  EXPECT_NEAR(w.inplane_um, 200, 1e-6);
+  // The camera's split, the default.
+  const auto z = gtrack::compare_to_truth(m, truth, within);
+  EXPECT_NEAR(z.depth_um, 200, 1e-6);
+  EXPECT_NEAR(z.inplane_um, 0, 1e-6);
+}
+
 TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
   auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
   const auto& m = g->model();

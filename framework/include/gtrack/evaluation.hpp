@@ -47,6 +47,9 @@ struct ErrorStats {
 };
 
 struct FrameErrors {
+  // depth_um along the sensor's viewing axis (a camera's optical axis, the
+  // normal of an ultrasound slice), inplane_um across it: world z and x-y
+  // for a camera looking down world z.
   double position_um = 0, inplane_um = 0, depth_um = 0;
   double orientation_deg = 0;
   Eigen::Vector3d axis_deg{0, 0, 0};  // |Euler angle differences| about x, y, z
@@ -75,10 +78,16 @@ struct FrameErrors {
 
 // Compares one estimate with one truth, modulo the model's symmetry.
 // `line_of_sight` (any length, either sign) is the sensor's viewing
-// direction at the truth's palm centre, for FrameErrors::tilt_mirror.
+// direction at the truth's palm centre, for FrameErrors::tilt_mirror;
+// `viewing_axis` (unit length) splits the position error into depth and
+// in-plane.
 GTRACK_API FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorXd& truth,
                                         const Eigen::VectorXd& estimate,
-                                        const Eigen::Vector3d& line_of_sight = Eigen::Vector3d::UnitZ());
+                                        const Eigen::Vector3d& line_of_sight = Eigen::Vector3d::UnitZ(),
+                                        const Eigen::Vector3d& viewing_axis = Eigen::Vector3d::UnitZ());
+// The sensor's viewing axis (unit length): a camera's optical axis, the
+// normal of an orthographic view or an ultrasound slice.
+GTRACK_API Eigen::Vector3d viewing_axis(const Projection& projection);
 // The line of sight of `projection` through the image of `world_mm` (unit
 // length; the optical ray of a camera, the plane's normal of a slice).
 GTRACK_API Eigen::Vector3d line_of_sight(const Projection& projection, const Eigen::Vector3d& world_mm);

@@ -73,6 +73,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   for (const auto& r : estimates.rows) by_frame[r.frame] = &r;
   const bool dims_match = estimates.fingers == model.fingers();
   const std::optional<Projection> projection = sensor ? std::optional<Projection>(sensor->projection()) : std::nullopt;
+  const Eigen::Vector3d axis = projection ? viewing_axis(*projection) : Eigen::Vector3d::UnitZ();
   std::vector<double> unmirrored;  // orientation errors of in-view frames that are no tilt mirror
   double mirrored_sum = 0, branch_sum = 0, orientation_sum = 0;
 
@@ -100,7 +101,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
     } else {
       const Eigen::Vector3d sight =
           projection ? line_of_sight(*projection, t.h.head<3>()) : Eigen::Vector3d::UnitZ();
-      fe.errors = compare_to_truth(model, t.h, it->second->h, sight);
+      fe.errors = compare_to_truth(model, t.h, it->second->h, sight, axis);
       if (fe.out_of_view) {
         ev.out_of_view.add(fe.errors);
       } else {

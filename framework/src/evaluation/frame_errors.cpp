@@ -66,8 +66,18 @@ Eigen::Vector3d line_of_sight(const Projection& projection, const Eigen::Vector3
   return d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::UnitZ();
 }
 
+Eigen::Vector3d viewing_axis(const Projection& projection) {
+  // P = [M | p4]: a camera's principal ray runs along M's third row; an
+  // affine view (third row zero) looks along what neither image axis sees.
+  const Eigen::Matrix3d m = projection.world_to_image.leftCols<3>();
+  Eigen::Vector3d axis = m.row(2).transpose();
+  if (axis.norm() == 0) axis = m.row(0).transpose().cross(m.row(1).transpose());
+  return axis.norm() > 0 ? Eigen::Vector3d(axis.normalized()) : Eigen::Vector3d::UnitZ();
+}
+
 FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorXd& truth,
-                             const Eigen::VectorXd& estimate, const Eigen::Vector3d& line_of_sight) {
+                             const Eigen::VectorXd& estimate, const Eigen::Vector3d& line_of_sight,
+                             const Eigen::Vector3d& viewing_axis) {
   const auto truth_ends = model.link_endpoints(truth);
   const int order = std::max(1, model.geometry().symmetry_order);
   FrameErrors best;
@@ -86,8 +96,9 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
     f.endpoint_um = 1000 * end;
     const Eigen::Vector3d d = e.head<3>() - truth.head<3>();
     f.position_um = 1000 * d.norm();
-    f.inplane_um = 1000 * d.head<2>().norm();
-    f.depth_um = 1000 * std::abs(d.z());
+    const double along = d.dot(viewing_axis);
+    f.inplane_um = 1000 * (d - along * viewing_axis).norm();
+    f.depth_um = 1000 * std::abs(along);
     const Eigen::Vector3d te = euler_deg_from_rotation(rotation_from_euler_deg(truth[3], truth[4], truth[5]));
     f.orientation_deg = geodesic_angle_deg(te, e.segment<3>(3));
     for (int a = 0; a < 3; ++a) f.axis_deg[a] = wrap_deg(e[3 + a] - te[a]);
