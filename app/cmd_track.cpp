@@ -31,7 +31,7 @@ void install_sigint() {
   struct sigaction sa {};
   sa.sa_handler = on_sigint;
   sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESETHAND;
+  sa.sa_flags = SA_RESETHAND | SA_RESTART;  // a write to a slow --stream reader goes on
   for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
     // A signal the caller ignores (`nohup`, a background job's SIGINT) stays ignored.
     struct sigaction old {};
@@ -110,7 +110,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
   // A two-pass run cannot be resumed: its backward pass needs the whole forward run.
   const char* next = two_pass ? " (the same command with --resume instead of --two-pass continues the forward run)"
-                              : " (the same command with --resume continues)";
+                     : opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
+                                           : " (the same command with --resume continues)";
   if (s.cancelled && g_reader_gone) {
     std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames << " frames, kept in "
               << opt.out_dir.string() << next << "\n";

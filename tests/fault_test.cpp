@@ -399,6 +399,99 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), want);
 }
 
+// A followed folder as a camera's software writes JPEGs: one written in two
+// steps, with a pause well over a poll, is tracked once whole (a half JPEG
+// decodes, with a complaint); one that arrives after a later-named image
+// was tracked is said, by name, not tracked.
+TEST(Fault, FollowedFolderWaitsOutAHalfWrittenJpegAndNamesALateImage) {
+  const fs::path dir = fresh_dir("follow_jpeg");
+  const fs::path whole = dir / "whole", live = dir / "live";
+  fs::create_directories(whole);
+  fs::create_directories(live);
+  std::vector<std::string> jpeg(4);
+  const auto name = [](int i) { return "img" + std::to_string(i) + ".jpg"; };
+  for (int i = 0; i < 4; ++i) {
+    std::vector<uchar> bytes;
+    ASSERT_TRUE(cv::imencode(".jpg", frame_image(i), bytes));
+    jpeg[i].assign(bytes.begin(), bytes.end());
+    std::ofstream(whole / name(i), std::ios::binary) << jpeg[i];
+  }
+  const TrackRun r = make_run();
+  gtrack::TrackOptions ref;
+  ref.input = whole.string();
+  ref.out_dir = dir / "ref";
+  ref.progress = false;
+  gtrack::track_sequence(r.setup, r.config, ref);
+
+  gtrack::TrackOptions o;
+  o.input = live.string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  o.follow_input_s = 3.0;
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  std::jthread writer([&] {
+    std::ofstream(live / name(0), std::ios::binary) << jpeg[0];
+    {
+      std::ofstream half(live / name(1), std::ios::binary);
+      half << jpeg[1].substr(0, jpeg[1].size() / 2) << std::flush;
+      std::this_thread::sleep_for(std::chrono::milliseconds(400));
+      half << jpeg[1].substr(jpeg[1].size() / 2);
+    }
+    std::ofstream(live / name(3), std::ios::binary) << jpeg[3];
+    // img2 once img3's row is written (header and three rows).
+    for (int i = 0; i < 3000 && read_lines(o.out_dir / "estimates.csv").size() < 4; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    std::ofstream(live / name(2), std::ios::binary) << jpeg[2];
+  });
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  writer.join();
+  gtrack::logger().sinks().pop_back();
+  EXPECT_EQ(s.frames, 3);
+  const auto rows = read_lines(o.out_dir / "estimates.csv"), ref_rows = read_lines(ref.out_dir / "estimates.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  ASSERT_EQ(ref_rows.size(), 5u);
+  // Frames 0 and 1 as from the whole images (all but the time column).
+  for (int i : {1, 2}) EXPECT_EQ(rows[i].substr(0, rows[i].rfind(',')), ref_rows[i].substr(0, ref_rows[i].rfind(',')));
+  EXPECT_NE(log.str().find(name(2) + ": arrived after img3.jpg was tracked"), std::string::npos) << log.str();
+}
+
+// Ctrl-C while a followed folder is waited on, for a new image or for one
+// still being written (here never finished), ends the run as cancelled:
+// not as a run that ran out of images, nor as an unreadable image.
+TEST(Fault, ACancelWhileFollowingEndsTheRunAsCancelled) {
+  for (const bool half : {false, true}) {
+    SCOPED_TRACE(half ? "an image half written" : "waiting for an image");
+    const fs::path dir = fresh_dir(half ? "follow_cancel_half" : "follow_cancel_wait");
+    const fs::path staged = write_frames(dir / "staged", 2), live = dir / "live";
+    fs::create_directories(live);
+    fs::copy_file(staged / "000000.png", live / "000000.png");
+    if (half) {
+      const std::string bytes = read_text(staged / "000001.png");
+      std::ofstream(live / "000001.png", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    }
+    const TrackRun r = make_run();
+    gtrack::TrackOptions o;
+    o.input = live.string();
+    o.out_dir = dir / "out";
+    o.progress = false;
+    o.follow_input_s = 60.0;
+    std::atomic<bool> cancel{false};
+    o.cancel = &cancel;
+    std::jthread stopper([&] {
+      for (int i = 0; i < 3000 && read_lines(o.out_dir / "estimates.csv").size() < 2; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      cancel = true;
+    });
+    const auto s = gtrack::track_sequence(r.setup, r.config, o);
+    EXPECT_TRUE(s.cancelled);
+    EXPECT_EQ(s.frames, 1);
+  }
+}
+
 // A fresh run into an earlier run's folder: the files of that run the new
 // one might not rewrite go first, so a new run that fails part way never
 // leaves the old summary or overlay beside its own rows. Other files stay.

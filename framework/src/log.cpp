@@ -24,10 +24,12 @@ void set_log_level(std::string_view level) {
                 "'; expected one of trace, debug, info, warn, error, critical, off");
   }
   logger().set_level(lvl);
-  // OpenCV's own messages (a camera backend probing, a codec's warnings)
-  // show only when gtrack's are asked for at debug level or finer.
+  // OpenCV's own warnings (a camera backend probing, a codec) show only when
+  // gtrack's are asked for at debug level or finer. Never its info lines:
+  // OpenCV writes those to stdout, which holds results (--stream's JSON
+  // lines, eval's report) and nothing else.
   namespace cvlog = cv::utils::logging;
-  cvlog::setLogLevel(lvl <= spdlog::level::debug ? cvlog::LOG_LEVEL_INFO
+  cvlog::setLogLevel(lvl <= spdlog::level::debug ? cvlog::LOG_LEVEL_WARNING
                      : lvl == spdlog::level::off ? cvlog::LOG_LEVEL_SILENT
                                                  : cvlog::LOG_LEVEL_ERROR);
 }

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string_view>
 #include <thread>
+#include <unordered_set>
 #include <chrono>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -266,7 +267,9 @@ class FolderSource final : public FrameSource {
         f.index = i;
         f.time_s = fps_ > 0 ? i / fps_ : 0.0;
         f.name = p.string();
-        f.image = to_bgr(read(p), f.name);
+        cv::Mat image = read(p);
+        if (image.empty()) return std::nullopt;  // cancelled while the image was still being written
+        f.image = to_bgr(image, f.name);
         check_size(f.image, expected_, p.string());
         return f;
       }
@@ -283,18 +286,26 @@ class FolderSource final : public FrameSource {
  private:
   bool following() const { return follow_.idle_s > 0; }
 
-  // The folder's images in name order. Following, only names after the last
-  // one taken are added: the order of what was tracked never changes.
+  // The folder's images in name order. Following, an image that arrives
+  // late, named before one already tracked, is not tracked (the frame
+  // numbers of what was tracked never change) and is warned about; one named
+  // before images listed but not yet tracked takes its place among them.
   void scan() {
     static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
-    std::vector<fs::path> found;
     std::error_code ec;  // of the listing itself
+    if (following() && unchanged_since_last_listing()) return;
+    std::vector<fs::path> found;
     for (fs::directory_iterator it(dir_, ec), end; !ec && it != end; it.increment(ec)) {
-      std::error_code entry_ec;  // an entry that vanished or dangles is skipped
+      // Names seen before are not looked at again: a followed folder of an
+      // hour's frames is listed every 20 ms.
+      const std::string name = it->path().filename().string();
+      if (known_.count(name)) continue;
+      std::error_code entry_ec;  // an entry that vanished or dangles is skipped, and looked at again
       if (!it->is_regular_file(entry_ec)) continue;
+      known_.insert(name);
       // Hidden files are no frames: a copy's metadata (macOS "._name.png")
       // or an image still being written under a temporary name.
-      if (it->path().filename().string().front() == '.') continue;
+      if (name.front() == '.') continue;
       const std::string ext = lowercase_extension(it->path());
       if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(it->path());
     }
@@ -317,7 +328,17 @@ class FolderSource final : public FrameSource {
     int gaps = 0;
     std::string first_gap;
     for (const auto& f : found) {
-      if (!files_.empty() && !before(files_.back(), f)) continue;
+      if (!files_.empty() && !before(files_.back(), f)) {
+        const auto at = std::upper_bound(files_.begin(), files_.end(), f, before);
+        if (at - files_.begin() >= index_) {
+          files_.insert(at, f);
+        } else {
+          logger().warn("{}: arrived after {} was tracked; a followed folder's images are tracked in name order, so "
+                        "it is not tracked",
+                        f.string(), files_[static_cast<size_t>(index_ - 1)].filename().string());
+        }
+        continue;
+      }
       const int step = files_.empty() ? -1 : numbered_next(files_.back(), f);
       if (step == 1) ++numbered_steps_;
       if (step == 0 && gaps++ == 0) first_gap = files_.back().filename().string() + " to " + f.filename().string();
@@ -330,6 +351,23 @@ class FolderSource final : public FrameSource {
                     dir_.string(), first_gap,
                     gaps == 1 ? "" : " and at " + std::to_string(gaps - 1) + (gaps == 2 ? " more place" : " more places"));
     }
+  }
+
+  // Following: whether the folder cannot have changed since it was last
+  // listed. Its modification time changes with every entry added, removed
+  // or renamed; it is trusted once the listing came well after it (a file
+  // system may keep whole seconds only).
+  bool unchanged_since_last_listing() {
+    std::error_code ec;
+    const auto mtime = fs::last_write_time(dir_, ec);
+    if (ec) return false;
+    const bool same = listed_ && mtime == listed_mtime_ && listed_late_;
+    if (!same) {
+      listed_ = true;
+      listed_mtime_ = mtime;
+      listed_late_ = fs::file_time_type::clock::now() - mtime > std::chrono::seconds(2);
+    }
+    return same;
   }
 
   // Following: polls the folder until a new image appears (true), or none
@@ -353,8 +391,9 @@ class FolderSource final : public FrameSource {
   // An image that does not decode is an error. Following, it may still be
   // being written: while its size keeps changing, or for two seconds after
   // it last changed, it is read again (also when it decodes but the decoder
-  // complains, as it does about a half-written JPEG). An image returned
-  // with the decoder's complaint gets a warning naming it.
+  // complains, as it does about a half-written JPEG: it is taken once its
+  // size has stayed for those two seconds, with a warning naming it). A
+  // cancel while waiting returns an empty image.
   cv::Mat read(const fs::path& p) const {
     auto changed = std::chrono::steady_clock::now();
     std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
@@ -376,11 +415,12 @@ class FolderSource final : public FrameSource {
         last_size = size;
       }
       const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0;
-      if (!img.empty() && (said.empty() || (!growing && last_size != static_cast<std::uintmax_t>(-1)))) {
+      if (!img.empty() && (said.empty() || settled)) {
         if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
         return img;
       }
       if (settled) fail_to_read(p, said);
+      if (follow_.cancel && follow_.cancel->load()) return {};
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
@@ -393,6 +433,9 @@ class FolderSource final : public FrameSource {
   fs::path dir_;
   std::vector<fs::path> files_;
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
+  std::unordered_set<std::string> known_;       // names listed so far
+  bool listed_ = false, listed_late_ = false;  // see unchanged_since_last_listing()
+  fs::file_time_type listed_mtime_;
   ImageSize expected_;
   RangeFilter filter_;
   double fps_;
@@ -777,6 +820,9 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
                                                double fallback_fps, const FollowOptions& follow) {
   if (follow.idle_s > 0) {
     std::error_code ec;
+    if (!fs::exists(spec, ec) && spec.rfind("camera:", 0) != 0) {
+      throw InputError(spec + ": no such folder; expected the folder of images to follow (create it before the run)");
+    }
     if (!fs::is_directory(spec, ec)) {
       throw InputError(spec + ": only a folder of images can be followed (a camera is live already; a video file is "
                               "read to its end)");

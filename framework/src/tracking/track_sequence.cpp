@@ -168,8 +168,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   if (options.follow_stimulus && options.resume) {
     throw InputError(
-        "a run that follows its stimulus log cannot be resumed: which reading each finished frame took is not "
-        "recorded");
+        "a run that follows its stimulus log cannot be resumed: its frames took the log's last row as it was "
+        "written, which the finished log no longer tells apart");
   }
   std::map<int, Eigen::VectorXd> restart_rows;
   if (options.restart_from) {
@@ -210,14 +210,16 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   const std::string run =
       shown("input=" + (options.input.rfind("camera:", 0) == 0 ? options.input : absolute(options.input)) +
                 " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
-                (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")),
+                (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")) +
+                (options.follow_stimulus ? " followed" : ""),
             1 << 16);
   if (options.resume && fs::exists(state_file)) {
     resumed = read_tracker_state(state_file);
     if (!resumed->run.empty() && resumed->run != run) {
       throw InputError(state_file.string() + ": the interrupted run tracked " + shown(resumed->run, 300) +
                        "; this one " + shown(run, 300) +
-                       "; cannot resume (give the same --input, --every and --stimulus, or another --out)");
+                       "; cannot resume (give the same --input, --every and --stimulus, or another --out; a run that followed its "
+                       "stimulus log cannot be resumed)");
     }
     detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root);
     const int every = std::max(1, range.every);
@@ -343,7 +345,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     const auto t_read = Clock::now();
     std::optional<Frame> frame = source->next();
-    if (!frame) break;
+    if (!frame) {
+      // A followed folder's wait ends at a cancel as at its idle limit.
+      summary.cancelled = options.cancel && options.cancel->load();
+      break;
+    }
     double io_ms = seconds_since(t_read) * 1e3;
     const double time_s = frame->index / fps;
     const std::optional<double> reading = reading_at(frame->index, time_s);
