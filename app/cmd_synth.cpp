@@ -1,8 +1,10 @@
 // gtrack synth: a synthetic sequence with ground truth (paper Section 5.1).
+#include <algorithm>
 #include <iostream>
 
 #include "command.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/plugin_loader.hpp"
 #include "gtrack/synth.hpp"
 
@@ -26,12 +28,27 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (!(o.occlusion_scale >= 0 && o.occlusion_scale <= 1)) {
     throw gtrack::cli::UsageError("--occlusion-scale must be in [0, 1]");
   }
-  const gtrack::SynthPreset& preset = gtrack::synth_preset(o.preset);
   const std::filesystem::path config = vm.count("config") ? std::filesystem::path(vm["config"].as<std::string>())
-                                                          : gtrack::data_dir() / "configs" / preset.config;
+                                                          : gtrack::data_dir() / "configs" /
+                                                                gtrack::synth_preset(o.preset).config;
   gtrack::SetupOptions so;
   so.plugin_paths = common.plugin_paths;
   gtrack::Setup setup = gtrack::load_setup(config, so);
+  // A config given without --preset: the preset whose config it is, else
+  // the look its sensor segments (an ultrasound slice's grey levels, or a
+  // camera's colour), so that the frames are ones its config can track.
+  const std::string look = setup.sensor->segmentation_defaults().color_space;
+  const auto grey = [](const gtrack::SynthPreset& p) { return p.gripper_hsv[1] == 0; };
+  if (vm.count("config") && vm["preset"].defaulted()) {
+    const auto& all = gtrack::synth_presets();
+    const auto same = std::find_if(all.begin(), all.end(), [&](const auto& p) { return p.config == config.filename(); });
+    o.preset = same != all.end() ? same->name : look == "luminance" ? "ultrasound" : "microscope";
+  } else if (grey(gtrack::synth_preset(o.preset)) != (look == "luminance")) {
+    gtrack::logger().warn("--preset {} draws {} frames, but {}'s sensor segments {}: its config will not find the "
+                          "gripper in them (leave --preset out to take the sensor's)",
+                          o.preset, grey(gtrack::synth_preset(o.preset)) ? "grey-level" : "colour", config.string(),
+                          look == "luminance" ? "grey levels" : "colour");
+  }
   const std::filesystem::path out = vm["out"].as<std::string>();
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
   std::string unit;
@@ -66,7 +83,8 @@ GTRACK_COMMAND(
           "out,o", po::value<std::string>()->required(), "folder to write")(
           "frames,n", po::value<int>()->default_value(300), "number of frames")(
           "seed,s", po::value<std::string>()->default_value("1"), "random seed: same seed, same sequence")(
-          "preset", po::value<std::string>()->default_value("microscope"), "setup: motion, look and noise")(
+          "preset", po::value<std::string>()->default_value("microscope"),
+          "setup: motion, look and noise (with --config: by default the one of its sensor, ultrasound for a slice)")(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(
           "occlusion-scale", po::value<double>()->default_value(1.0),

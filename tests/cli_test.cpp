@@ -726,6 +726,27 @@ TEST(Cli, SweepChecksItsConfigAndFolderFirst) {
 // A config that names a file by a relative path (a calibration beside it):
 // the sequence's config names it absolutely, and tracks from there. A
 // config given as a pipe is read once.
+// synth --config without --preset draws what the config's sensor segments:
+// an ultrasound config (here a copy under another name) gets the
+// ultrasound preset's grey frames; a preset whose look the sensor does not
+// segment is warned about.
+TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_preset";
+  fs::remove_all(dir);
+  const fs::path lab = write("synth_preset_lab.toml", read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" /
+                                                                "ultrasound_hydrogel.toml"));
+  CliRun r = gtrack("synth --config " + lab.string() + " --frames 2 --out " + (dir / "a").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("(preset ultrasound, seed 1)"), std::string::npos) << r.output;
+  EXPECT_NE(read_file(dir / "a" / "sequence.toml").find("(preset 'ultrasound'"), std::string::npos);
+  r = gtrack("synth --config " + lab.string() + " --preset microscope --frames 1 --out " + (dir / "b").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("--preset microscope draws colour frames, but " + lab.string() +
+                          "'s sensor segments grey levels"),
+            std::string::npos)
+      << r.output;
+}
+
 TEST(Cli, SynthKeepsTheConfigsFilesAndReadsAPipeOnce) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_files";
   fs::remove_all(dir);
