@@ -1147,3 +1147,22 @@ TEST(TextFile, BoundsAndFailedWritesAreOneLineErrors) {
   }
   fs::remove_all(dir);
 }
+
+// A unit mistake that makes the gripper sub-pixel (a focal length in
+// millimetres instead of pixels) is said when the setup is loaded, with both
+// sizes; the shipped scale is not.
+TEST(Fault, AGripperAFewPixelsAcrossIsWarnedAbout) {
+  const auto warnings = [](const std::string& text) {
+    std::ostringstream log;
+    gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+    const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "units.toml"), {});
+    gtrack::logger().sinks().pop_back();
+    return log.str();
+  };
+  EXPECT_EQ(warnings(kConfig).find("pixels across"), std::string::npos) << warnings(kConfig);
+  std::string tiny = kConfig;
+  for (const char* key : {"fx = 1600.0", "fy = 1600.0"}) tiny.replace(tiny.find(key), 11, std::string(key, 5) + "1.6");
+  const std::string said = warnings(tiny);
+  EXPECT_NE(said.find("units.toml: the gripper (4 mm across, open) is 0.064 pixels across"), std::string::npos) << said;
+  EXPECT_NE(said.find("check the units of [gripper] and [sensor]"), std::string::npos) << said;
+}

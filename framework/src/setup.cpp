@@ -34,6 +34,21 @@ void warn_on_reference_mismatch(const ConfigTable& stimulus, const GripperGeomet
   }
 }
 
+// A gripper a few pixels across, or wider than the image, at the sensor's
+// scale is mostly a unit mistake (a gripper in metres, micrometres per pixel
+// typed as millimetres): said once, with both sizes, instead of every frame
+// being lost without a reason.
+void warn_on_scale_mismatch(const ConfigTable& root, const Sensor& sensor, const ArticulatedModel& model) {
+  const double mm_per_px = sensor.mm_per_pixel();
+  const ImageSize size = sensor.image_size();
+  if (!(mm_per_px > 0) || size.width <= 0 || size.height <= 0) return;
+  const double across_px = 2 * model.radius_mm() / mm_per_px;
+  if (across_px >= 4 && across_px <= 4.0 * std::max(size.width, size.height)) return;
+  logger().warn("{}: the gripper ({:.4g} mm across, open) is {:.3g} pixels across at the sensor's {:.4g} mm per pixel "
+                "in its {}x{} image; check the units of [gripper] and [sensor] (millimetres)",
+                root.source(), 2 * model.radius_mm(), across_px, mm_per_px, size.width, size.height);
+}
+
 }  // namespace
 
 Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
@@ -55,6 +70,7 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   }
   s.sensor = loader->make_sensor(root.table("sensor"));
   s.gripper = loader->make_gripper(root.table("gripper"));
+  warn_on_scale_mismatch(root, *s.sensor, s.model());
   if (options.with_stimulus) {
     if (!root.has("stimulus")) {
       root.fail("stimulus", "missing table [stimulus]; it must name a stimulus plugin" + root.misspelling_hint("stimulus"));
