@@ -4,6 +4,10 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <thread>
+
+#include <poll.h>
+#include <unistd.h>
 
 #include "command.hpp"
 #include "gtrack/engine_config.hpp"
@@ -106,6 +110,20 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   }
   opt.cancel = &g_stop;
   install_sigint();
+  // --stream: a reader that goes away while no line is written (a followed
+  // folder waiting for images) is noticed too, as the pipe's error.
+  std::jthread reader_watch;
+  if (stream) {
+    reader_watch = std::jthread([](std::stop_token stop) {
+      while (!stop.stop_requested() && !g_stop) {
+        pollfd out{STDOUT_FILENO, 0, 0};
+        if (::poll(&out, 1, 100) > 0 && (out.revents & (POLLERR | POLLHUP))) {
+          g_reader_gone = true;
+          g_stop = true;
+        }
+      }
+    });
+  }
 
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
   // A two-pass run cannot be resumed: its backward pass needs the whole forward run.

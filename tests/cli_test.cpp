@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -162,6 +163,22 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   EXPECT_NE(e.find("gtrack track: stdout was closed by its reader; stopped after "), std::string::npos) << e;
   const std::string s = read_file(dir / "out" / "summary.json");
   EXPECT_NE(s.find("\"cancelled\": true"), std::string::npos) << s;
+
+  // ...also while no line is being written: a followed folder whose images
+  // stopped coming. The run ends when the reader does, not after the idle
+  // time (120 s here), and says why.
+  const fs::path live = dir / "live";
+  fs::create_directories(live);
+  fs::copy_file(dir / "frames" / "000000.png", live / "000000.png");
+  const auto start = std::chrono::steady_clock::now();
+  const CliRun waiting =
+      gtrack(std::string("track -c ") + (dir / "sequence.toml").string() + " -i " + live.string() + " -o " +
+                 (dir / "out_live").string() + " --no-overlay --stream --follow-input 120",
+             "2>" + err.string() + " | head -n 1");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
+  EXPECT_EQ(lines(waiting.output), 1) << waiting.output;
+  EXPECT_NE(read_file(err).find("stdout was closed by its reader; stopped after 1 frames"), std::string::npos)
+      << read_file(err);
 }
 
 std::vector<std::vector<std::string>> read_csv(const fs::path& file) {
