@@ -17,6 +17,7 @@ namespace {
 
 void write_obj(const std::string& path, const std::vector<Eigen::Vector3d>& tris) {
   std::ostringstream out;
+  out.precision(10);  // 0.1 um at 100 mm from the camera
   out << "# gtrack posed gripper mesh, millimetres, world frame\n";
   for (const auto& v : tris) out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
   for (size_t i = 0; i < tris.size(); i += 3) out << "f " << i + 1 << " " << i + 2 << " " << i + 3 << "\n";
@@ -69,8 +70,8 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   }
   const cv::Mat mask = renderer->render_mask(h);
   if (cv::countNonZero(mask) == 0) {
-    gtrack::logger().warn("the posed model covers no pixel of the image (outside the view, behind the camera or "
-                          "nearer than its near plane)");
+    gtrack::logger().warn("the posed model covers no pixel of the image (outside the view, outside an ultrasound "
+                          "slice's slab, behind the camera or nearer than its near plane)");
   }
   if (!cv::imwrite(out, mask)) throw gtrack::InputError(out + ": cannot write the image");
   std::cout << "mask " << mask.cols << "x" << mask.rows << " (" << cv::countNonZero(mask) << " pixels, "

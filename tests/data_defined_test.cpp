@@ -100,6 +100,20 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   clockwise.replace(clockwise.find("[[0.4, 0.0], [0.0, 0.4], [-0.4, 0.0], [0.0, -0.4]]"), 50,
                     "[[0.4, 0.0], [0.0, -0.4], [-0.4, 0.0], [0.0, 0.4]]");
   EXPECT_NE(config_error(clockwise).find("<test>:3: key 'palm_mm'"), std::string::npos) << config_error(clockwise);
+  // A concave palm (the fan of triangles would cover its notch), a bowtie
+  // whose lobes leave a positive area, and a pentagram, which turns left at
+  // every point but winds around twice.
+  for (const auto& [palm, said] : std::vector<std::pair<std::string, std::string>>{
+           {"[[0.4, 0.0], [0.0, 0.4], [0.0, 0.1], [-0.4, 0.0], [0.0, -0.4]]", "turns clockwise at point 3"},
+           {"[[0.0, 0.1], [0.3, 0.0], [0.3, 0.2], [0.0, 0.0]]", "turns clockwise at point"},
+           {"[[0.4, 0.0], [-0.3236, 0.2351], [0.1236, -0.3804], [0.1236, 0.3804], [-0.3236, -0.2351]]",
+            "winds around more than once"}}) {
+    std::string bent = kFourFinger;
+    bent.replace(bent.find("[[0.4, 0.0], [0.0, 0.4], [-0.4, 0.0], [0.0, -0.4]]"), 50, palm);
+    bent.replace(bent.find("symmetry_order = 4"), 18, "symmetry_order = 1");
+    const std::string e = config_error(bent);
+    EXPECT_NE(e.find("<test>:3: key 'palm_mm': the palm polygon " + said), std::string::npos) << palm << ": " << e;
+  }
   // Widths do not match the links.
   std::string widths = kFourFinger;
   widths.replace(widths.find("link_widths_mm = [0.4, 0.3, 0.0]"), 32, "link_widths_mm = [0.4, 0.3]");
@@ -123,6 +137,8 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   EXPECT_EQ(config_error(with_adjacent("[[1, 2], [2, 3], [3, 4], [4, 1]]")), "");
   std::string half = config_error(with_adjacent("[[1.5, 2]]"));
   EXPECT_NE(half.find("key 'adjacent': expected pairs of whole finger numbers"), std::string::npos) << half;
+  std::string twice = config_error(with_adjacent("[[1, 2], [2, 3], [2, 1]]"));
+  EXPECT_NE(twice.find("key 'adjacent': fingers 1 and 2 are paired twice"), std::string::npos) << twice;
   std::string self = config_error(with_adjacent("[[2, 2]]"));
   EXPECT_NE(self.find("key 'adjacent': a finger cannot be adjacent to itself"), std::string::npos) << self;
   // Sizes no micro-gripper has: refused with the key and the bound.

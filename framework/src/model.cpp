@@ -50,6 +50,29 @@ Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg) {
   return t;
 }
 
+std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& palm) {
+  // Counter-clockwise and convex: every turn at a point is to the left (or
+  // straight on); a polygon that crosses itself turns more than once around.
+  const size_t n = palm.size();
+  double area = 0, turned = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d a = palm[(i + n - 1) % n], b = palm[i], c = palm[(i + 1) % n];
+    area += b.x() * c.y() - b.y() * c.x();
+    const Eigen::Vector2d in = b - a, out = c - b;
+    const double cross = in.x() * out.y() - in.y() * out.x();
+    if (cross < -1e-12 * std::max(1.0, in.squaredNorm() + out.squaredNorm())) {
+      return "the palm polygon turns clockwise at point " + std::to_string(i + 1) +
+             "; expected a convex polygon, its points counter-clockwise";
+    }
+    turned += std::atan2(cross, in.dot(out));
+  }
+  if (!(area > 0)) return "the palm polygon has no positive area; expected a convex polygon, its points counter-clockwise";
+  if (turned > 2 * std::numbers::pi + 1e-6) {
+    return "the palm polygon winds around more than once (it crosses itself); expected a convex polygon";
+  }
+  return "";
+}
+
 std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger_shift) {
   const int F = static_cast<int>(G.fingers.size());
   std::vector<int> shift(F);
@@ -119,6 +142,9 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
 ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) {
   const auto& G = geometry_;
   if (G.palm_mm.size() < 3) throw Error("gripper '" + G.name + "': the palm polygon needs at least 3 points");
+  if (const std::string bent = palm_shape_mismatch(G.palm_mm); !bent.empty()) {
+    throw Error("gripper '" + G.name + "': " + bent);
+  }
   if (G.fingers.empty()) throw Error("gripper '" + G.name + "': it has no fingers");
   if (!(G.joint_min_deg < G.joint_max_deg)) throw Error("gripper '" + G.name + "': joint_min must be below joint_max");
   if (G.symmetry_order < 1) throw Error("gripper '" + G.name + "': symmetry order must be >= 1");

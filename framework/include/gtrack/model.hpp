@@ -114,6 +114,10 @@ class GTRACK_API ArticulatedModel {
   std::vector<int> finger_shift_;  // finger permutation for one symmetry step
 };
 
+// Why a palm polygon is not one the mesh can be made of ("" when it is):
+// its points must run counter-clockwise around a convex polygon.
+GTRACK_API std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& palm);
+
 // Why a geometry's symmetry_order does not hold ("" when it does): a turn
 // by 360/order must take every palm point onto a palm point and every finger
 // onto a finger of the same links, at its hinge and in its direction.

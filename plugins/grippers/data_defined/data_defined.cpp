@@ -61,15 +61,14 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   } else {
     for (const auto& p : t.number_rows("palm_mm", 2, kPlace)) g.palm_mm.emplace_back(p[0], p[1]);
     if (g.palm_mm.size() < 3) t.fail("palm_mm", "the palm needs at least 3 points");
-    double area = 0;
-    for (size_t i = 0; i < g.palm_mm.size(); ++i) {
-      const auto& a = g.palm_mm[i];
-      const auto& b = g.palm_mm[(i + 1) % g.palm_mm.size()];
-      area += a.x() * b.y() - a.y() * b.x();
-    }
-    if (area <= 0) t.fail("palm_mm", "the palm polygon must be counter-clockwise with a positive area");
+    if (const std::string bent = gtrack::palm_shape_mismatch(g.palm_mm); !bent.empty()) t.fail("palm_mm", bent);
     const auto fingers = t.tables("finger");
-    if (fingers.empty()) t.fail("finger", "missing; add one [[finger]] table per finger (or use [radial])");
+    if (fingers.empty()) {
+      const std::string array = "[[" + (t.path().empty() ? std::string() : t.path() + ".") + "finger]]";
+      t.fail("finger", "missing; add one " + array + " table per finger, after the " +
+                           (t.path().empty() ? std::string("top-level") : "[" + t.path() + "]") +
+                           " keys (or use [radial])");
+    }
     for (const auto& f : fingers) {
       gtrack::FingerShape F;
       auto b = f.numbers("base_mm", 2, kPlace);
@@ -89,7 +88,14 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
         t.fail("adjacent", "expected pairs of whole finger numbers (1-based)");
       }
       if (p[0] == p[1]) t.fail("adjacent", "a finger cannot be adjacent to itself");
-      g.collision.adjacent.emplace_back(static_cast<int>(p[0]) - 1, static_cast<int>(p[1]) - 1);
+      const std::pair<int, int> pair(static_cast<int>(p[0]) - 1, static_cast<int>(p[1]) - 1);
+      for (const auto& [a, b] : g.collision.adjacent) {
+        if ((a == pair.first && b == pair.second) || (a == pair.second && b == pair.first)) {
+          t.fail("adjacent", "fingers " + std::to_string(a + 1) + " and " + std::to_string(b + 1) +
+                                 " are paired twice; expected each pair once (it would count twice in K(H))");
+        }
+      }
+      g.collision.adjacent.push_back(pair);
     }
   }
   g.joint_min_deg = t.number_or("joint_min_deg", 0, Range::closed(-180, 180));
@@ -113,7 +119,10 @@ gtrack::ArticulatedModel load_model(const ConfigTable& t) {
   const std::filesystem::path file = t.file_path("model_file");
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) t.fail("model_file", file.string() + " is a folder; expected a TOML file");
-  if (!std::filesystem::is_regular_file(file, ec)) t.fail("model_file", file.string() + " does not exist");
+  if (!std::filesystem::exists(file, ec)) t.fail("model_file", file.string() + " does not exist");
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    t.fail("model_file", file.string() + " is not a regular file; expected a TOML file");
+  }
   const ConfigTable m = ConfigTable::load_file(file.string());
   gtrack::GripperGeometry g = read_geometry(m);
   m.check_all_used();

@@ -21,7 +21,7 @@ class UltrasoundSlice final : public gtrack::Sensor {
     height_ = static_cast<int>(t.integer_or("height", 662, Range{1, 65536}));
     s_ = t.number_or("mm_per_pixel", 0.09, Range::positive());
     slab_ = t.number_or("slab_thickness_mm", 0.6, Range::positive());
-    auto p = t.numbers_or("probe_position_mm", {0, 0, 0}, 3);
+    auto p = t.numbers_or("probe_position_mm", {0, 0, 0}, 3, Range::closed(-1e4, 1e4));  // within 10 m
     auto r = t.numbers_or("probe_rotation_deg", {0, 0, 0}, 3, Range::closed(-360, 360));
     origin_ = Eigen::Vector3d(p[0], p[1], p[2]);
     R_ = gtrack::rotation_from_euler_deg(r[0], r[1], r[2]);
