@@ -11,6 +11,7 @@
 
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/model.hpp"
 #include "gtrack/observation.hpp"
 #include "gtrack/renderer.hpp"
 #include "gtrack/sequence_io.hpp"
@@ -51,6 +52,34 @@ TEST(Synth, SegmentedFrameMatchesTheRenderedTruth) {
     EXPECT_NEAR(ratio, 1.0, 0.03) << "frame " << i;
   }
   EXPECT_GE(checked, 2);
+}
+
+// A probe turned in the world (its slice now the world's x-z plane) gets
+// the sequence an upright one gets, turned with it: every frame's palm
+// centre in its slab and its palm facing along the slice's normal as much
+// as the upright probe's do.
+TEST(Synth, ATurnedProbeSeesTheSequenceAnUprightOneSees) {
+  const std::string upright_text =
+      "[sensor]\nplugin = \"ultrasound_slice\"\n[gripper]\nplugin = \"hydrogel_six_finger\"\n"
+      "[stimulus]\nplugin = \"temperature_hysteresis\"\n";
+  std::string turned_text = upright_text;
+  turned_text.insert(turned_text.find("[gripper]"), "probe_rotation_deg = [90, 0, 0]\n");
+  const gtrack::Setup upright = gtrack::load_setup(gtrack::ConfigTable::parse(upright_text, "u.toml"), {});
+  const gtrack::Setup turned = gtrack::load_setup(gtrack::ConfigTable::parse(turned_text, "t.toml"), {});
+  gtrack::SynthOptions o;
+  o.frames = 30;
+  o.preset = "ultrasound";
+  const auto a = gtrack::plan_sequence(upright, o), b = gtrack::plan_sequence(turned, o);
+  const Eigen::Matrix3d frame = gtrack::rotation_from_euler_deg(90, 0, 0);
+  const Eigen::Vector3d na = upright.sensor->nominal_position_mm(), nb = turned.sensor->nominal_position_mm();
+  for (int i = 0; i < o.frames; ++i) {
+    const Eigen::VectorXd &ha = a.frames[i].truth, &hb = b.frames[i].truth;
+    EXPECT_LT((frame * (ha.head<3>() - na) - (hb.head<3>() - nb)).norm(), 1e-9) << "frame " << i;
+    const Eigen::Matrix3d ra = gtrack::rotation_from_euler_deg(ha[3], ha[4], ha[5]);
+    const Eigen::Matrix3d rb = gtrack::rotation_from_euler_deg(hb[3], hb[4], hb[5]);
+    EXPECT_LT((frame * ra - rb).norm(), 1e-9) << "frame " << i;
+    EXPECT_EQ(ha.tail(6), hb.tail(6)) << "frame " << i;
+  }
 }
 
 TEST(Synth, SameSeedSameSequence) {

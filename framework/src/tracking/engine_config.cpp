@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "gtrack/error.hpp"
+#include "gtrack/evaluation.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
 
 namespace gtrack {
@@ -120,7 +123,8 @@ bool box_meets_view(const Projection& p, const Eigen::Vector3d& lo, const Eigen:
 
 std::string vec_text(const Eigen::Vector3d& v) {
   char buf[96];
-  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  const auto shown = [](double x) { return std::abs(x) < 1e-9 ? 0.0 : x; };  // no 2.2e-16 or -0
+  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", shown(v.x()), shown(v.y()), shown(v.z()));
   return buf;
 }
 
@@ -143,6 +147,19 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
   for (int i = 0; i < 3; ++i) {
     if (!(s.position_min_mm[i] < s.position_max_mm[i])) t.fail("position_min_mm", "must be below position_max_mm");
     if (!(s.rotation_min_deg[i] < s.rotation_max_deg[i])) t.fail("rotation_min_deg", "must be below rotation_max_deg");
+  }
+  // The orientation's parameters are about world z: rx, ry within the
+  // bounds (+-90 deg by default) keep the palm facing +z, and the tilt mirror
+  // is taken about z. A sensor that looks along another axis sees the
+  // gripper face on only at the bounds.
+  const Eigen::Vector3d axis = viewing_axis(sensor.projection());
+  const double off_z = std::acos(std::min(1.0, std::abs(axis.z()))) * 180 / std::numbers::pi;
+  if (off_z > 30) {
+    logger().warn("{}: the [sensor] looks along {}, {:.0f} deg from world z, but the tracker's orientation is taken about "
+                  "world z (rx, ry within [search] rotation_min_deg..rotation_max_deg, the tilt mirror about z): "
+                  "tilted grippers will be found at the bounds or upside down. Track in the sensor's own frame (for "
+                  "ultrasound_slice: probe_rotation_deg = [0, 0, 0]) and turn the estimates afterwards",
+                  t.source(), vec_text(axis), off_z);
   }
   if (!box_meets_view(sensor.projection(), s.position_min_mm.array() - radius, s.position_max_mm.array() + radius)) {
     t.fail("position_min_mm", "the box up to position_max_mm lies wholly outside the sensor's view, the model's "
