@@ -1083,6 +1083,8 @@ TEST(Fault, ImplausibleConfigValuesAreRefusedWithFileLineKey) {
       {"tracker", "default_stimulus", "1e300"},
       {"gripper", "folded_deg", "500"},
       {"gripper", "unfolded_deg", "-10"},
+      {"sensor", "fx", "1e300"},
+      {"sensor", "working_distance_mm", "1e300"},
       {"cost", "lambda_dice", "0.0"},  // the image would not count
       {"render", "scale", "0.05"},     // 6x6 render pixels
       // A search box beside the field of view (both bounds below each other).

@@ -221,8 +221,11 @@ class PinholeMicroscope final : public gtrack::Sensor {
     } else {
       width_ = static_cast<int>(t.integer("width", Range{1, 65536}));
       height_ = static_cast<int>(t.integer("height", Range{1, 65536}));
-      fx_ = t.number("fx", Range::positive());
-      fy_ = t.number_or("fy", fx_, Range::positive());
+      // A focal length of 10^8 pixels sees a hundredth of a micrometre per
+      // pixel at a metre: past it is a typing mistake.
+      const Range focal{0.0, 1e8, true, false};
+      fx_ = t.number("fx", focal);
+      fy_ = t.number_or("fy", fx_, focal);
       // cx, cy as calibration tools give them (OpenCV: pixel centres on integers).
       // A principal point far outside the image is a unit or typing mistake.
       cx_ = t.number_or("cx", (width_ - 1) / 2.0, Range::closed(-10.0 * width_, 11.0 * width_));
@@ -234,8 +237,8 @@ class PinholeMicroscope final : public gtrack::Sensor {
                                  std::to_string(dist_.size()));
       }
     }
-    near_ = t.number_or("near_mm", 1.0, Range::positive());
-    working_distance_ = t.number_or("working_distance_mm", 100.0, Range::positive());
+    near_ = t.number_or("near_mm", 1.0, Range{0.0, 1e5, true, false});
+    working_distance_ = t.number_or("working_distance_mm", 100.0, Range{0.0, 1e5, true, false});  // up to 100 m
     if (near_ >= working_distance_) t.fail("near_mm", "must be less than working_distance_mm");
     K_ = (cv::Mat_<double>(3, 3) << fx_, 0, cx_, 0, fy_, cy_, 0, 0, 1);
     has_distortion_ = false;
