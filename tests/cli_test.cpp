@@ -335,7 +335,7 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   const std::string base = hydrogel_config();
   const fs::path key = write("fxx.toml", replaced(base, "\nfx = ", "\nfxx = "));
   CliRun r = gtrack("render -c " + key.string() + kParams);
-  expect_refusal(r, "key 'sensor.fx': missing; expected a number > 0 (is 'fxx' on line ");
+  expect_refusal(r, "key 'sensor.fx': missing; expected a number in (0, 1e+08] (is 'fxx' on line ");
   const fs::path plugin =
       write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
   r = gtrack("render -c " + plugin.string() + kParams);
