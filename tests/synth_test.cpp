@@ -82,6 +82,23 @@ TEST(Synth, ATurnedProbeSeesTheSequenceAnUprightOneSees) {
   }
 }
 
+// A config's camera rate ([tracker] fps) is the sequence's frame rate.
+TEST(Synth, TheConfigsFrameRateIsTheSequences) {
+  const std::string text = "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\nfx = 3200.0\n"
+                           "[gripper]\nplugin = \"hydrogel_six_finger\"\n[stimulus]\nplugin = "
+                           "\"temperature_hysteresis\"\n[tracker]\nfps = 100.0\n";
+  const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "fps.toml"), {});
+  gtrack::SynthOptions o;
+  o.frames = 3;
+  const auto plan = gtrack::plan_sequence(setup, o);
+  EXPECT_DOUBLE_EQ(plan.preset.frame_rate_hz, 100.0);
+  EXPECT_DOUBLE_EQ(plan.frames[2].time_s, 0.02);
+  std::string slow = text;
+  slow.replace(slow.find("fps = 100.0"), 11, "fps = 1e-6");
+  EXPECT_THROW(gtrack::plan_sequence(gtrack::load_setup(gtrack::ConfigTable::parse(slow, "fps.toml"), {}), o),
+               gtrack::ConfigError);
+}
+
 TEST(Synth, SameSeedSameSequence) {
   const gtrack::Setup setup = microscope();
   gtrack::SynthOptions o;
