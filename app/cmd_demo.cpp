@@ -10,6 +10,7 @@
 #include "gtrack/plugin_loader.hpp"
 #include "gtrack/synth.hpp"
 #include "gtrack/synthetic_benchmark.hpp"
+#include "gtrack/text_file.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/two_pass.hpp"
 
@@ -60,10 +61,7 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   const fs::path two_pass_csv = to.out_dir / "two_pass" / "estimates.csv";
   const auto ev2 =
       gtrack::evaluate(setup.model(), truth, gtrack::read_pose_table(two_pass_csv), {}, setup.sensor.get());
-  {
-    std::ofstream json(out / "evaluation.json");
-    json << gtrack::evaluation_json(ev);
-  }
+  gtrack::write_text_file(out / "evaluation.json", gtrack::evaluation_json(ev));
   gtrack::write_frame_errors(out / "frame_errors.csv", ev);
 
   const auto& e = ev.in_view;

@@ -18,6 +18,7 @@
 #include "gtrack/plugin_loader.hpp"
 #include "gtrack/synth.hpp"
 #include "gtrack/synthetic_benchmark.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace po = boost::program_options;
 namespace fs = std::filesystem;
@@ -141,7 +142,7 @@ fs::path make_sequence(const Context& c, std::uint64_t seed, double noise) {
   gtrack::SetupOptions so;
   so.plugin_paths = c.common.plugin_paths;
   gtrack::write_synthetic_sequence(gtrack::load_setup(c.config, so), o, dir);
-  std::ofstream(stamp, std::ios::binary) << recipe;
+  gtrack::write_text_file(stamp, recipe);
   return dir;
 }
 

@@ -35,17 +35,24 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   so.plugin_paths = common.plugin_paths;
   gtrack::Setup setup = gtrack::load_setup(config, so);
   // A config given without --preset: the preset whose config it is, else
-  // the look its sensor segments (an ultrasound slice's grey levels, or a
-  // camera's colour), so that the frames are ones its config can track.
-  const std::string look = setup.sensor->segmentation_defaults().color_space;
+  // one of the look the config segments (grey levels for luminance, as an
+  // ultrasound slice's default is; colour otherwise), so that the frames
+  // are ones the config can track.
+  const std::string sensor_look = setup.sensor->segmentation_defaults().color_space;
+  const std::string look = setup.root.table("observation")
+                               .choice_or("color_space", sensor_look == "luminance" ? sensor_look : "hsv",
+                                          {"hsv", "luminance"});
   const auto grey = [](const gtrack::SynthPreset& p) { return p.gripper_hsv[1] == 0; };
   if (vm.count("config") && vm["preset"].defaulted()) {
     const auto& all = gtrack::synth_presets();
-    const auto same = std::find_if(all.begin(), all.end(), [&](const auto& p) { return p.config == config.filename(); });
+    const auto same = std::find_if(all.begin(), all.end(), [&](const auto& p) {
+      return p.config == config.filename() && grey(p) == (look == "luminance");
+    });
     o.preset = same != all.end() ? same->name : look == "luminance" ? "ultrasound" : "microscope";
-  } else if (grey(gtrack::synth_preset(o.preset)) != (look == "luminance")) {
-    gtrack::logger().warn("--preset {} draws {} frames, but {}'s sensor segments {}: its config will not find the "
-                          "gripper in them (leave --preset out to take the sensor's)",
+  }
+  if (grey(gtrack::synth_preset(o.preset)) != (look == "luminance")) {
+    gtrack::logger().warn("--preset {} draws {} frames, but {} segments {}: its config will not find the "
+                          "gripper in them (leave --preset out to take one it can)",
                           o.preset, grey(gtrack::synth_preset(o.preset)) ? "grey-level" : "colour", config.string(),
                           look == "luminance" ? "grey levels" : "colour");
   }
@@ -84,7 +91,7 @@ GTRACK_COMMAND(
           "frames,n", po::value<int>()->default_value(300), "number of frames")(
           "seed,s", po::value<std::string>()->default_value("1"), "random seed: same seed, same sequence")(
           "preset", po::value<std::string>()->default_value("microscope"),
-          "setup: motion, look and noise (with --config: by default the one of its sensor, ultrasound for a slice)")(
+          "setup: motion, look and noise (with --config: by default one of the look it segments, ultrasound for luminance)")(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(
           "occlusion-scale", po::value<double>()->default_value(1.0),

@@ -110,10 +110,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   }
   opt.cancel = &g_stop;
   install_sigint();
-  // --stream: a reader that goes away while no line is written (a followed
-  // folder waiting for images) is noticed too, as the pipe's error.
+  // --stream on a followed folder: a reader that goes away while the folder
+  // is waited on, so that no line is written, is noticed as the pipe's error.
   std::jthread reader_watch;
-  if (stream) {
+  if (stream && opt.follow_input_s > 0) {
     reader_watch = std::jthread([](std::stop_token stop) {
       while (!stop.stop_requested() && !g_stop) {
         pollfd out{STDOUT_FILENO, 0, 0};

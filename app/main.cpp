@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "command.hpp"
 #include "gtrack/config.hpp"
 #include "gtrack/error.hpp"
@@ -143,6 +146,12 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A standard stream the caller closed (`gtrack ... >&-`) is /dev/null:
+  // otherwise the first file opened would take its number, and what is
+  // printed would be written into it.
+  for (int fd = 0; fd <= 2; ++fd) {
+    if (::fcntl(fd, F_GETFD) == -1 && ::open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) != fd) return 1;
+  }
   try {
     std::vector<char*> args = command_first(argc, argv);
     return run(static_cast<int>(args.size()), args.data());

@@ -179,6 +179,17 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   EXPECT_EQ(lines(waiting.output), 1) << waiting.output;
   EXPECT_NE(read_file(err).find("stdout was closed by its reader; stopped after 1 frames"), std::string::npos)
       << read_file(err);
+
+  // stdout closed before the run (`>&-`): the lines go nowhere, not into the
+  // first file opened, which would take stdout's number.
+  const CliRun closed = gtrack(track_of(dir) + " --frames 0:2 -o " + (dir / "out_closed").string() +
+                                   " --no-overlay --stream",
+                               ">&- 2>/dev/null");
+  EXPECT_EQ(closed.code, 0);
+  for (const char* file : {"estimates.csv", "run_config.toml", "tracker_state.txt"}) {
+    EXPECT_EQ(read_file(dir / "out_closed" / file).find("{\"frame\""), std::string::npos) << file;
+  }
+  EXPECT_EQ(read_file(dir / "out_closed" / "estimates.csv").rfind("frame,x_mm", 0), 0u);
 }
 
 std::vector<std::vector<std::string>> read_csv(const fs::path& file) {
@@ -756,10 +767,16 @@ TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("(preset ultrasound, seed 1)"), std::string::npos) << r.output;
   EXPECT_NE(read_file(dir / "a" / "sequence.toml").find("(preset 'ultrasound'"), std::string::npos);
+  // A camera config that segments by luminance gets grey frames too.
+  const fs::path grey_camera =
+      write("synth_preset_grey.toml", read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "tests" / "data" /
+                                                "microscope_128.toml") +
+                                          "\n[observation]\ncolor_space = \"luminance\"\n");
+  r = gtrack("synth --config " + grey_camera.string() + " --frames 1 --out " + (dir / "c").string());
+  EXPECT_NE(r.output.find("(preset ultrasound, seed 1)"), std::string::npos) << r.output;
   r = gtrack("synth --config " + lab.string() + " --preset microscope --frames 1 --out " + (dir / "b").string());
   EXPECT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("--preset microscope draws colour frames, but " + lab.string() +
-                          "'s sensor segments grey levels"),
+  EXPECT_NE(r.output.find("--preset microscope draws colour frames, but " + lab.string() + " segments grey levels"),
             std::string::npos)
       << r.output;
 }

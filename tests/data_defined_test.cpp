@@ -169,8 +169,8 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
         two.substr(two.find("[[finger]]\nbase_mm = [-0.2, -0.2]"));
   two.erase(two.find("[[finger]]\nbase_mm = [0.2, -0.2]"));
   const std::string e = config_error(two);
-  EXPECT_NE(e.find("<test>:4: key 'symmetry_order': a turn by 90 deg takes finger 1 where no finger of the same "
-                   "shape is"),
+  EXPECT_NE(e.find("<test>:4: key 'symmetry_order': a turn by 90 deg takes finger 1: its hinge to [-0.2, 0.2], "
+                   "where no finger has its hinge"),
             std::string::npos)
       << e;
   std::string two_fold = two;
@@ -178,16 +178,45 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
   EXPECT_EQ(config_error(two_fold), "");
   std::string oblong = kFourFinger;
   oblong.replace(oblong.find("[[0.4, 0.0], [0.0, 0.4]"), 23, "[[0.6, 0.0], [0.0, 0.4]");
-  EXPECT_NE(config_error(oblong).find("takes palm point 1 [0.6, 0] to [0, 0.6], where the palm has no point"),
+  EXPECT_NE(config_error(oblong).find("takes palm point 1 [0.6, 0] to [0, 0.6], 0.2 mm off the palm's outline"),
             std::string::npos)
       << config_error(oblong);
   std::string longer = kFourFinger;
   longer.replace(longer.rfind("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 0.4]");
-  EXPECT_NE(config_error(longer).find("key 'symmetry_order'"), std::string::npos) << config_error(longer);
-  // Hand-typed coordinates of a regular shape (three decimals) are the shape.
+  EXPECT_NE(config_error(longer).find("key 'symmetry_order': a turn by 90 deg takes finger 3: it onto finger 4, "
+                                      "whose links differ"),
+            std::string::npos)
+      << config_error(longer);
+  std::string turned = kFourFinger;
+  turned.replace(turned.find("direction_deg = 135"), 19, "direction_deg = 150");
+  EXPECT_NE(config_error(turned).find("takes finger 1: its direction to 135 deg, where finger 2 at its hinge points "
+                                      "to 150 deg"),
+            std::string::npos)
+      << config_error(turned);
+  // Hand-typed coordinates of a regular shape are the shape: a few um off,
+  // or rounded to 0.01 mm on a palm 0.4 mm across.
   std::string typed = kFourFinger;
   typed.replace(typed.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.201, 0.199]");
   EXPECT_EQ(config_error(typed), "");
+  // A round palm of many points, whose turn by a third lands between them
+  // (on its outline), with three fingers; its points rounded to 0.01 mm.
+  std::string round = "plugin = \"data_defined\"\nsymmetry_order = 3\npalm_mm = [";
+  for (int i = 0; i < 64; ++i) {
+    char p[48];
+    std::snprintf(p, sizeof p, "%s[%.2f, %.2f]", i ? ", " : "", 0.5 * std::cos(2 * M_PI * i / 64),
+                  0.5 * std::sin(2 * M_PI * i / 64));
+    round += p;
+  }
+  round += "]\n";
+  for (int f = 0; f < 3; ++f) {
+    char finger[200];
+    std::snprintf(finger, sizeof finger,
+                  "[[finger]]\nbase_mm = [%.2f, %.2f]\ndirection_deg = %d\nlink_lengths_mm = [0.3]\n"
+                  "link_widths_mm = [0.2, 0.1]\n",
+                  0.5 * std::cos(2 * M_PI * f / 3), 0.5 * std::sin(2 * M_PI * f / 3), 120 * f);
+    round += finger;
+  }
+  EXPECT_EQ(config_error(round), "");
 }
 
 // Two parallel fingers on each side (a fork): a half turn takes each finger

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 
 #include "gtrack/error.hpp"
@@ -51,22 +52,33 @@ Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg) {
 }
 
 std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& palm) {
-  // Counter-clockwise and convex: every turn at a point is to the left (or
-  // straight on); a polygon that crosses itself turns more than once around.
+  // Counter-clockwise and convex: no point lies inside the line from the
+  // point before it to the point after it by more than 2 % of the palm's
+  // size or 10 um (coordinates of a round palm rounded to 0.01 mm do, by a
+  // little); a polygon that crosses itself turns more than once around.
   const size_t n = palm.size();
-  double area = 0, turned = 0;
+  double area = 0, size = 0;
+  for (size_t i = 0; i < n; ++i) {
+    area += palm[i].x() * palm[(i + 1) % n].y() - palm[i].y() * palm[(i + 1) % n].x();
+    size = std::max(size, palm[i].norm());
+  }
+  if (!(area > 0)) {
+    return area < 0 ? "the palm polygon's points run clockwise; expected them counter-clockwise, around a convex polygon"
+                    : "the palm polygon has no area; expected a convex polygon, its points counter-clockwise";
+  }
+  double turned = 0;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d a = palm[(i + n - 1) % n], b = palm[i], c = palm[(i + 1) % n];
-    area += b.x() * c.y() - b.y() * c.x();
-    const Eigen::Vector2d in = b - a, out = c - b;
-    const double cross = in.x() * out.y() - in.y() * out.x();
-    if (cross < -1e-12 * std::max(1.0, in.squaredNorm() + out.squaredNorm())) {
-      return "the palm polygon turns clockwise at point " + std::to_string(i + 1) +
-             "; expected a convex polygon, its points counter-clockwise";
+    const Eigen::Vector2d chord = c - a, in = b - a, out = c - b;
+    const double inside = chord.norm() > 0 ? (chord.x() * in.y() - chord.y() * in.x()) / chord.norm() : 0;
+    if (inside > std::max(0.02 * size, 0.01)) {
+      char dent[64];
+      std::snprintf(dent, sizeof dent, "%.3g mm", inside);
+      return "the palm polygon turns clockwise at point " + std::to_string(i + 1) + " (" + dent +
+             " inside its neighbours' line); expected a convex polygon, its points counter-clockwise";
     }
-    turned += std::atan2(cross, in.dot(out));
+    turned += std::atan2(in.x() * out.y() - in.y() * out.x(), in.dot(out));
   }
-  if (!(area > 0)) return "the palm polygon has no positive area; expected a convex polygon, its points counter-clockwise";
   if (turned > 2 * std::numbers::pi + 1e-6) {
     return "the palm polygon winds around more than once (it crosses itself); expected a convex polygon";
   }
@@ -79,18 +91,21 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
   for (int f = 0; f < F; ++f) shift[f] = f;
   if (finger_shift) *finger_shift = shift;
   if (G.symmetry_order <= 1) return "";
-  // Positions agree to 2 % of the palm's size (hand-typed coordinates of a
-  // regular shape), directions to 1 degree, links to 2 % of their size.
+  // Positions agree to 2 % of the palm's size, and to 10 um at least
+  // (hand-typed coordinates of a regular shape, rounded to 0.01 mm),
+  // directions to 1 degree, links to 2 % of their size.
   double size = 0;
   for (const auto& p : G.palm_mm) size = std::max(size, p.norm());
   for (const auto& f : G.fingers) size = std::max(size, f.base_mm.norm());
-  const double tol = 0.02 * size + 1e-9;
+  const double tol = std::max(0.02 * size, 0.01);
   const double step = 360.0 / G.symmetry_order;
   const double c = std::cos(step * kDeg), sn = std::sin(step * kDeg);
   const auto turned = [&](const Eigen::Vector2d& p) { return Eigen::Vector2d(c * p.x() - sn * p.y(), sn * p.x() + c * p.y()); };
-  const auto angle_apart = [](double a, double b) {
-    const double d = std::fmod(std::abs(a - b), 360.0);
-    return std::min(d, 360.0 - d);
+  const auto shown = [](double v) { return std::abs(v) < 1e-9 ? 0.0 : v; };  // no -0 or 3.7e-17
+  const auto point = [&](const Eigen::Vector2d& p) {
+    char text[64];
+    std::snprintf(text, sizeof text, "[%.4g, %.4g]", shown(p.x()), shown(p.y()));
+    return std::string(text);
   };
   const auto close = [](double a, double b) { return std::abs(a - b) <= 0.02 * std::max(std::abs(a), std::abs(b)) + 1e-6; };
   const auto same_links = [&](const FingerShape& a, const FingerShape& b) {
@@ -107,33 +122,52 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
   std::snprintf(turn, sizeof turn, "a turn by %g deg", step);
   const std::string head = std::string(turn) + " takes ";
   const std::string tail = "; expected the number of turns that map the palm and every finger onto themselves (1 for none)";
-  for (size_t i = 0; i < G.palm_mm.size(); ++i) {
+  // The palm: each turned point on the palm's outline (a round palm's
+  // points need not land on points).
+  const size_t n = G.palm_mm.size();
+  for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d p = turned(G.palm_mm[i]);
-    const bool found = std::any_of(G.palm_mm.begin(), G.palm_mm.end(), [&](const auto& q) { return (q - p).norm() <= tol; });
-    if (!found) {
-      char at[96];
-      const auto shown = [](double v) { return std::abs(v) < 1e-9 ? 0.0 : v; };  // no -0 or 3.7e-17
-      std::snprintf(at, sizeof at, "palm point %zu [%g, %g] to [%.4g, %.4g]", i + 1, G.palm_mm[i].x(),
-                    G.palm_mm[i].y(), shown(p.x()), shown(p.y()));
-      return head + at + ", where the palm has no point" + tail;
+    double off = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < n; ++k) {
+      const Eigen::Vector2d a = G.palm_mm[k], e = G.palm_mm[(k + 1) % n] - a;
+      const double t = e.squaredNorm() > 0 ? std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+      off = std::min(off, (a + t * e - p).norm());
+    }
+    if (off > tol) {
+      char by[48];
+      std::snprintf(by, sizeof by, ", %.3g mm off the palm's outline", off);
+      return head + "palm point " + std::to_string(i + 1) + " " + point(G.palm_mm[i]) + " to " + point(p) + by + tail;
     }
   }
-  // Finger f lands on finger shift[f]: its hinge, direction and links.
+  // Finger f lands on finger shift[f]: its hinge, direction and links. A
+  // finger that lands on none is named with the one nearest its hinge.
   std::vector<bool> taken(F, false);
   for (int f = 0; f < F; ++f) {
     const FingerShape& a = G.fingers[f];
     const Eigen::Vector2d base = turned(a.base_mm);
-    int best = -1;
-    for (int g = 0; g < F && best < 0; ++g) {
-      const FingerShape& b = G.fingers[g];
-      if ((b.base_mm - base).norm() <= tol && angle_apart(a.direction_deg + step, b.direction_deg) <= 1.0 && same_links(a, b)) best = g;
+    const double direction = a.direction_deg + step;
+    int nearest = 0;
+    for (int g = 1; g < F; ++g) {
+      if ((G.fingers[g].base_mm - base).norm() < (G.fingers[nearest].base_mm - base).norm()) nearest = g;
     }
-    if (best < 0 || taken[best]) {
-      return head + "finger " + std::to_string(f + 1) + " where " +
-             (best < 0 ? std::string("no finger of the same shape is") : "finger " + std::to_string(best + 1) + " lands as well") + tail;
+    const FingerShape& b = G.fingers[nearest];
+    std::string why;
+    if ((b.base_mm - base).norm() > tol) {
+      why = "its hinge to " + point(base) + ", where no finger has its hinge (nearest: finger " +
+            std::to_string(nearest + 1) + " at " + point(b.base_mm) + ")";
+    } else if (std::abs(std::remainder(direction - b.direction_deg, 360.0)) > 1.0) {
+      char text[96];
+      std::snprintf(text, sizeof text, "its direction to %g deg, where finger %d at its hinge points to %g deg",
+                    shown(std::remainder(direction, 360.0)), nearest + 1, b.direction_deg);
+      why = text;
+    } else if (!same_links(a, b)) {
+      why = "it onto finger " + std::to_string(nearest + 1) + ", whose links differ";
+    } else if (taken[nearest]) {
+      why = "it onto finger " + std::to_string(nearest + 1) + ", where another finger lands as well";
     }
-    taken[best] = true;
-    shift[f] = best;
+    if (!why.empty()) return head + "finger " + std::to_string(f + 1) + ": " + why + tail;
+    taken[nearest] = true;
+    shift[f] = nearest;
   }
   if (finger_shift) *finger_shift = shift;
   return "";
@@ -166,14 +200,9 @@ ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) 
   double extent = 0;
   for (const auto& F : G.fingers) {
     links += static_cast<int>(F.links.size());
-    double reach = F.base_mm.norm();  // to the fingertip, stretched out
-    for (const auto& l : F.links) {
-      reach += l.length_mm;
-      extent = std::max({extent, l.width_start_mm, l.width_end_mm});
-    }
-    extent = std::max(extent, reach);
+    for (const auto& l : F.links) extent = std::max({extent, l.width_start_mm, l.width_end_mm});
   }
-  for (const auto& p : G.palm_mm) extent = std::max(extent, p.norm());
+  extent = std::max(extent, radius_mm());  // the palm and the fingertips, stretched out
   if (links > kMaxLinks) {
     throw Error("gripper '" + G.name + "': " + std::to_string(links) + " links over its " +
                 std::to_string(fingers()) + " fingers; at most " + std::to_string(kMaxLinks) + " are supported");

@@ -286,15 +286,16 @@ class FolderSource final : public FrameSource {
  private:
   bool following() const { return follow_.idle_s > 0; }
 
-  // The folder's images in name order. Following, an image that arrives
-  // late, named before one already tracked, is not tracked (the frame
-  // numbers of what was tracked never change) and is warned about; one named
-  // before images listed but not yet tracked takes its place among them.
+  // The folder's images in name order. Following, scan() runs once every
+  // image listed so far was taken: an image that arrives late, named before
+  // the last one taken, is not tracked (the frame numbers of what was taken
+  // never change) and is warned about.
   void scan() {
     static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
-    std::error_code ec;  // of the listing itself
     if (following() && unchanged_since_last_listing()) return;
+    std::error_code ec;  // of the listing itself
     std::vector<fs::path> found;
+    std::vector<std::string> seen;  // names to skip from the next listing on, if this one completes
     for (fs::directory_iterator it(dir_, ec), end; !ec && it != end; it.increment(ec)) {
       // Names seen before are not looked at again: a followed folder of an
       // hour's frames is listed every 20 ms.
@@ -302,7 +303,7 @@ class FolderSource final : public FrameSource {
       if (known_.count(name)) continue;
       std::error_code entry_ec;  // an entry that vanished or dangles is skipped, and looked at again
       if (!it->is_regular_file(entry_ec)) continue;
-      known_.insert(name);
+      seen.push_back(name);
       // Hidden files are no frames: a copy's metadata (macOS "._name.png")
       // or an image still being written under a temporary name.
       if (name.front() == '.') continue;
@@ -310,33 +311,30 @@ class FolderSource final : public FrameSource {
       if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(it->path());
     }
     if (ec) {
-      // Following, a listing that fails once is tried again at the next poll.
+      // Following, a listing that fails is made again, whole, at the next poll.
       if (!following() || files_.empty()) {
         throw InputError(dir_.string() + ": cannot list the folder (" + ec.message() + ")");
       }
+      listed_ = false;
       return;
     }
+    known_.insert(seen.begin(), seen.end());
     const auto before = [](const fs::path& a, const fs::path& b) {
       return natural_less(a.filename().string(), b.filename().string());
     };
     // Numbers in names compare by value: frame9.png before frame10.png.
     std::sort(found.begin(), found.end(), before);
     // Frames are numbered by their order here, so a number missing from
-    // the names (a dropped frame) shifts every frame after it: said once per
-    // listing, with the first gap, when most names do count up by one
-    // (names that carry a time stamp do not).
+    // the names (a dropped frame) shifts every frame after it: said once,
+    // with the first gap, when most names do count up by one (names that
+    // carry a time stamp do not).
     int gaps = 0;
     std::string first_gap;
     for (const auto& f : found) {
       if (!files_.empty() && !before(files_.back(), f)) {
-        const auto at = std::upper_bound(files_.begin(), files_.end(), f, before);
-        if (at - files_.begin() >= index_) {
-          files_.insert(at, f);
-        } else {
-          logger().warn("{}: arrived after {} was tracked; a followed folder's images are tracked in name order, so "
-                        "it is not tracked",
-                        f.string(), files_[static_cast<size_t>(index_ - 1)].filename().string());
-        }
+        logger().warn("{}: arrived after {}, which comes after it in name order; a followed folder's images are "
+                      "taken in name order as they arrive, so it is not tracked",
+                      f.string(), files_.back().filename().string());
         continue;
       }
       const int step = files_.empty() ? -1 : numbered_next(files_.back(), f);
@@ -345,7 +343,8 @@ class FolderSource final : public FrameSource {
       files_.push_back(f);
     }
     number_gaps_ += gaps;
-    if (gaps > 0 && numbered_steps_ >= number_gaps_) {
+    if (gaps > 0 && numbered_steps_ >= number_gaps_ && !warned_gap_) {
+      warned_gap_ = true;
       logger().warn("{}: the images' numbers skip from {}{}; frames are numbered by their order in the folder (0, 1, "
                     "2, ...), not by their names, so after a gap a frame's number is not the one in its name",
                     dir_.string(), first_gap,
@@ -355,19 +354,23 @@ class FolderSource final : public FrameSource {
 
   // Following: whether the folder cannot have changed since it was last
   // listed. Its modification time changes with every entry added, removed
-  // or renamed; it is trusted once the listing came well after it (a file
-  // system may keep whole seconds only).
+  // or renamed, in steps as coarse as the file system keeps (whole seconds
+  // on some): a time is trusted once the folder was listed again more than
+  // 2 s, by this machine's clock, after it was first seen.
   bool unchanged_since_last_listing() {
     std::error_code ec;
     const auto mtime = fs::last_write_time(dir_, ec);
-    if (ec) return false;
-    const bool same = listed_ && mtime == listed_mtime_ && listed_late_;
-    if (!same) {
-      listed_ = true;
+    const auto now = std::chrono::steady_clock::now();
+    if (ec || !listed_ || mtime != listed_mtime_) {
+      listed_ = !ec;
       listed_mtime_ = mtime;
-      listed_late_ = fs::file_time_type::clock::now() - mtime > std::chrono::seconds(2);
+      mtime_seen_at_ = now;
+      mtime_trusted_ = false;
+      return false;
     }
-    return same;
+    if (mtime_trusted_) return true;
+    mtime_trusted_ = now - mtime_seen_at_ > std::chrono::seconds(2);  // after this listing
+    return false;
   }
 
   // Following: polls the folder until a new image appears (true), or none
@@ -414,7 +417,10 @@ class FolderSource final : public FrameSource {
         changed = now;
         last_size = size;
       }
-      const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0;
+      // Settled: unchanged for 2 s, as seen here or by the file's own time.
+      const auto written = fs::last_write_time(p, ec);
+      const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0 ||
+                           (!ec && fs::file_time_type::clock::now() - written > std::chrono::seconds(2));
       if (!img.empty() && (said.empty() || settled)) {
         if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
         return img;
@@ -433,9 +439,12 @@ class FolderSource final : public FrameSource {
   fs::path dir_;
   std::vector<fs::path> files_;
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
-  std::unordered_set<std::string> known_;       // names listed so far
-  bool listed_ = false, listed_late_ = false;  // see unchanged_since_last_listing()
+  bool warned_gap_ = false;
+  std::unordered_set<std::string> known_;  // names listed so far
+  // See unchanged_since_last_listing().
+  bool listed_ = false, mtime_trusted_ = false;
   fs::file_time_type listed_mtime_;
+  std::chrono::steady_clock::time_point mtime_seen_at_;
   ImageSize expected_;
   RangeFilter filter_;
   double fps_;

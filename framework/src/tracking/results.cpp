@@ -10,6 +10,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/sequence_io.hpp"
+#include "gtrack/text_file.hpp"
 #include "replace_file.hpp"
 
 namespace gtrack {
@@ -54,11 +55,8 @@ std::string csv_header(int fingers) { return pose_table_header(fingers, {"cost",
 
 // Whole lines only: a last line without its newline was cut short.
 std::vector<std::string> complete_lines(const fs::path& p) {
-  std::error_code ec;
-  if (fs::is_directory(p, ec)) throw InputError(p.string() + ": is a folder; expected a file of estimates");
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw InputError(p.string() + ": cannot open");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // A day of frames at 30 frames/s is some 800 MB of estimates.jsonl.
+  const std::string text = read_text_file(p, std::size_t(4) << 30, "a file of estimates");
   std::vector<std::string> lines;
   size_t start = 0;
   for (size_t nl; (nl = text.find('\n', start)) != std::string::npos; start = nl + 1) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gtrack/error.hpp"
+#include "gtrack/text_file.hpp"
 #include "replace_file.hpp"
 
 namespace gtrack::detail {
@@ -123,8 +124,11 @@ std::vector<std::string> header_lines(std::string_view text) {
 std::vector<std::string> file_header_lines(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::string text, line;
-  while (std::getline(in, line) && (line.rfind("# ", 0) == 0 || (text.empty() && line.rfind("\xEF\xBB\xBF# ", 0) == 0)) &&
-         text.size() < (64u << 20)) {
+  // As far as the header goes, within a config's size.
+  for (int n = 1; read_bounded_line(in, line, std::size_t(16) << 20, file.string(), n, "a TOML config") &&
+                  (line.rfind("# ", 0) == 0 || (text.empty() && line.rfind("\xEF\xBB\xBF# ", 0) == 0)) &&
+                  text.size() < (16u << 20);
+       ++n) {
     text += line + "\n";
   }
   return header_lines(std::string_view(text));

@@ -346,8 +346,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const auto t_read = Clock::now();
     std::optional<Frame> frame = source->next();
     if (!frame) {
-      // A followed folder's wait ends at a cancel as at its idle limit.
-      summary.cancelled = options.cancel && options.cancel->load();
+      // A followed folder's wait ends at a cancel as at its idle limit; any
+      // other source has simply ended.
+      summary.cancelled = options.follow_input_s > 0 && options.cancel && options.cancel->load();
       break;
     }
     double io_ms = seconds_since(t_read) * 1e3;
