@@ -104,10 +104,16 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   // whose lobes leave a positive area, and a pentagram, which turns left at
   // every point but winds around twice.
   for (const auto& [palm, said] : std::vector<std::pair<std::string, std::string>>{
-           {"[[0.4, 0.0], [0.0, 0.4], [0.0, 0.1], [-0.4, 0.0], [0.0, -0.4]]", "turns clockwise at point 3"},
-           {"[[0.0, 0.1], [0.3, 0.0], [0.3, 0.2], [0.0, 0.0]]", "turns clockwise at point"},
+           {"[[0.4, 0.0], [0.0, 0.4], [0.0, 0.1], [-0.4, 0.0], [0.0, -0.4]]", "is not convex: point 3 lies 0.2"},
+           {"[[0.0, 0.1], [0.3, 0.0], [0.3, 0.2], [0.0, 0.0]]", "crosses itself"},
            {"[[0.4, 0.0], [-0.3236, 0.2351], [0.1236, -0.3804], [0.1236, 0.3804], [-0.3236, -0.2351]]",
-            "winds around more than once"}}) {
+            "crosses itself"},
+           // A crescent: each point barely inside its neighbours' line, the
+           // inner arc far inside the hull.
+           {"[[0.45, -0.2], [0.39, 0.025], [0.225, 0.19], [0.0, 0.25], [-0.225, 0.19], [-0.39, 0.025], "
+            "[-0.45, -0.2], [-0.35, -0.2], [-0.303, -0.025], [-0.175, 0.103], [0.0, 0.15], [0.175, 0.103], "
+            "[0.303, -0.025], [0.35, -0.2]]",
+            "is not convex: point 9 lies"}}) {
     std::string bent = kFourFinger;
     bent.replace(bent.find("[[0.4, 0.0], [0.0, 0.4], [-0.4, 0.0], [0.0, -0.4]]"), 50, palm);
     bent.replace(bent.find("symmetry_order = 4"), 18, "symmetry_order = 1");
@@ -199,12 +205,13 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
   typed.replace(typed.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.201, 0.199]");
   EXPECT_EQ(config_error(typed), "");
   // A round palm of many points, whose turn by a third lands between them
-  // (on its outline), with three fingers; its points rounded to 0.01 mm.
+  // (on its outline), with three fingers; its points rounded to 0.01 mm, so
+  // that some repeat.
   std::string round = "plugin = \"data_defined\"\nsymmetry_order = 3\npalm_mm = [";
-  for (int i = 0; i < 64; ++i) {
+  for (int i = 0; i < 256; ++i) {
     char p[48];
-    std::snprintf(p, sizeof p, "%s[%.2f, %.2f]", i ? ", " : "", 0.5 * std::cos(2 * M_PI * i / 64),
-                  0.5 * std::sin(2 * M_PI * i / 64));
+    std::snprintf(p, sizeof p, "%s[%.2f, %.2f]", i ? ", " : "", 0.5 * std::cos(2 * M_PI * i / 256),
+                  0.5 * std::sin(2 * M_PI * i / 256));
     round += p;
   }
   round += "]\n";
@@ -217,6 +224,19 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
     round += finger;
   }
   EXPECT_EQ(config_error(round), "");
+  // Two fingers on one hinge, each side (a V): a half turn takes each onto
+  // the one of the other side's pair that points its way.
+  std::string vee = "plugin = \"data_defined\"\nsymmetry_order = 2\n"
+                    "palm_mm = [[0.45, -0.3], [0.45, 0.3], [-0.45, 0.3], [-0.45, -0.3]]\n";
+  for (const auto& [x, d] : std::vector<std::pair<double, int>>{{0.45, 30}, {0.45, -30}, {-0.45, 210}, {-0.45, 150}}) {
+    char finger[200];
+    std::snprintf(finger, sizeof finger,
+                  "[[finger]]\nbase_mm = [%.2f, 0.0]\ndirection_deg = %d\nlink_lengths_mm = [0.3]\n"
+                  "link_widths_mm = [0.2, 0.1]\n",
+                  x, d);
+    vee += finger;
+  }
+  EXPECT_EQ(config_error(vee), "");
 }
 
 // Two parallel fingers on each side (a fork): a half turn takes each finger

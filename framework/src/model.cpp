@@ -51,36 +51,83 @@ Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg) {
   return t;
 }
 
-std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& palm) {
-  // Counter-clockwise and convex: no point lies inside the line from the
-  // point before it to the point after it by more than 2 % of the palm's
-  // size or 10 um (coordinates of a round palm rounded to 0.01 mm do, by a
-  // little); a polygon that crosses itself turns more than once around.
+// The convex hull of points, counter-clockwise (Andrew's monotone chain).
+std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> p) {
+  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Eigen::Vector2d> hull(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  hull.resize(k > 1 ? k - 1 : k);
+  return hull;
+}
+
+// Distance from p to the closed polygon's outline.
+double distance_to_outline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon) {
+  double d = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < polygon.size(); ++k) {
+    const Eigen::Vector2d a = polygon[k], e = polygon[(k + 1) % polygon.size()] - a;
+    const double t = e.squaredNorm() > 0 ? std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+    d = std::min(d, (a + t * e - p).norm());
+  }
+  return d;
+}
+
+std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& points) {
+  // Counter-clockwise and convex: every point within 2 % of the palm's size,
+  // or 10 um, of its convex hull's outline (coordinates of a round palm
+  // rounded to 0.01 mm lie a little inside), and the outline going once
+  // around (a polygon that crosses itself turns more than once). A point
+  // repeated in a row is one point.
+  std::vector<Eigen::Vector2d> palm;
+  for (const auto& p : points) {
+    if (palm.empty() || (p - palm.back()).norm() > 1e-12) palm.push_back(p);
+  }
+  while (palm.size() > 1 && (palm.front() - palm.back()).norm() <= 1e-12) palm.pop_back();
   const size_t n = palm.size();
   double area = 0, size = 0;
   for (size_t i = 0; i < n; ++i) {
     area += palm[i].x() * palm[(i + 1) % n].y() - palm[i].y() * palm[(i + 1) % n].x();
     size = std::max(size, palm[i].norm());
   }
-  if (!(area > 0)) {
+  if (n < 3 || !(area > 0)) {
     return area < 0 ? "the palm polygon's points run clockwise; expected them counter-clockwise, around a convex polygon"
                     : "the palm polygon has no area; expected a convex polygon, its points counter-clockwise";
   }
-  double turned = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d a = palm[(i + n - 1) % n], b = palm[i], c = palm[(i + 1) % n];
-    const Eigen::Vector2d chord = c - a, in = b - a, out = c - b;
-    const double inside = chord.norm() > 0 ? (chord.x() * in.y() - chord.y() * in.x()) / chord.norm() : 0;
+  const std::vector<Eigen::Vector2d> hull = convex_hull(palm);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double inside = distance_to_outline(points[i], hull);
     if (inside > std::max(0.02 * size, 0.01)) {
       char dent[64];
       std::snprintf(dent, sizeof dent, "%.3g mm", inside);
-      return "the palm polygon turns clockwise at point " + std::to_string(i + 1) + " (" + dent +
-             " inside its neighbours' line); expected a convex polygon, its points counter-clockwise";
+      return "the palm polygon is not convex: point " + std::to_string(i + 1) + " lies " + dent +
+             " inside its convex outline; expected a convex polygon, its points counter-clockwise";
     }
+  }
+  double turned = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d in = palm[i] - palm[(i + n - 1) % n], out = palm[(i + 1) % n] - palm[i];
     turned += std::atan2(in.x() * out.y() - in.y() * out.x(), in.dot(out));
   }
-  if (turned > 2 * std::numbers::pi + 1e-6) {
-    return "the palm polygon winds around more than once (it crosses itself); expected a convex polygon";
+  // Once around, in the hull's order: a polygon that crosses itself turns
+  // other than once around (a bowtie not at all, a pentagram twice), or
+  // covers less than its hull.
+  double hull_area = 0;
+  for (size_t i = 0; i < hull.size(); ++i) {
+    hull_area += hull[i].x() * hull[(i + 1) % hull.size()].y() - hull[i].y() * hull[(i + 1) % hull.size()].x();
+  }
+  if (std::abs(turned - 2 * std::numbers::pi) > 1e-6 || area < 0.9 * hull_area) {
+    return "the palm polygon crosses itself (its outline does not go once around, in order); expected a convex "
+           "polygon, its points counter-clockwise";
   }
   return "";
 }
@@ -127,12 +174,7 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
   const size_t n = G.palm_mm.size();
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d p = turned(G.palm_mm[i]);
-    double off = std::numeric_limits<double>::infinity();
-    for (size_t k = 0; k < n; ++k) {
-      const Eigen::Vector2d a = G.palm_mm[k], e = G.palm_mm[(k + 1) % n] - a;
-      const double t = e.squaredNorm() > 0 ? std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
-      off = std::min(off, (a + t * e - p).norm());
-    }
+    const double off = distance_to_outline(p, G.palm_mm);
     if (off > tol) {
       char by[48];
       std::snprintf(by, sizeof by, ", %.3g mm off the palm's outline", off);
@@ -146,28 +188,42 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
     const FingerShape& a = G.fingers[f];
     const Eigen::Vector2d base = turned(a.base_mm);
     const double direction = a.direction_deg + step;
-    int nearest = 0;
-    for (int g = 1; g < F; ++g) {
-      if ((G.fingers[g].base_mm - base).norm() < (G.fingers[nearest].base_mm - base).norm()) nearest = g;
+    // The finger it lands on: at the turned hinge, in the turned direction,
+    // with the same links, not yet landed on.
+    const auto lands_on = [&](int g) {
+      const FingerShape& b = G.fingers[g];
+      return !taken[g] && (b.base_mm - base).norm() <= tol &&
+             std::abs(std::remainder(direction - b.direction_deg, 360.0)) <= 1.0 && same_links(a, b);
+    };
+    int target = -1;
+    for (int g = 0; g < F && target < 0; ++g) {
+      if (lands_on(g)) target = g;
     }
-    const FingerShape& b = G.fingers[nearest];
-    std::string why;
-    if ((b.base_mm - base).norm() > tol) {
-      why = "its hinge to " + point(base) + ", where no finger has its hinge (nearest: finger " +
-            std::to_string(nearest + 1) + " at " + point(b.base_mm) + ")";
-    } else if (std::abs(std::remainder(direction - b.direction_deg, 360.0)) > 1.0) {
-      char text[96];
-      std::snprintf(text, sizeof text, "its direction to %g deg, where finger %d at its hinge points to %g deg",
-                    shown(std::remainder(direction, 360.0)), nearest + 1, b.direction_deg);
-      why = text;
-    } else if (!same_links(a, b)) {
-      why = "it onto finger " + std::to_string(nearest + 1) + ", whose links differ";
-    } else if (taken[nearest]) {
-      why = "it onto finger " + std::to_string(nearest + 1) + ", where another finger lands as well";
+    if (target < 0) {
+      // Why not, said of the finger nearest the turned hinge.
+      int nearest = 0;
+      for (int g = 1; g < F; ++g) {
+        if ((G.fingers[g].base_mm - base).norm() < (G.fingers[nearest].base_mm - base).norm()) nearest = g;
+      }
+      const FingerShape& b = G.fingers[nearest];
+      std::string why;
+      if ((b.base_mm - base).norm() > tol) {
+        why = "its hinge to " + point(base) + ", where no finger has its hinge (nearest: finger " +
+              std::to_string(nearest + 1) + " at " + point(b.base_mm) + ")";
+      } else if (std::abs(std::remainder(direction - b.direction_deg, 360.0)) > 1.0) {
+        char text[128];
+        std::snprintf(text, sizeof text, "its direction to %g deg, where finger %d at its hinge points to %g deg",
+                      shown(std::remainder(direction, 360.0)), nearest + 1, b.direction_deg);
+        why = text;
+      } else if (!same_links(a, b)) {
+        why = "it onto finger " + std::to_string(nearest + 1) + ", whose links differ";
+      } else {
+        why = "it onto finger " + std::to_string(nearest + 1) + ", where another finger lands as well";
+      }
+      return head + "finger " + std::to_string(f + 1) + ": " + why + tail;
     }
-    if (!why.empty()) return head + "finger " + std::to_string(f + 1) + ": " + why + tail;
-    taken[nearest] = true;
-    shift[f] = nearest;
+    taken[target] = true;
+    shift[f] = target;
   }
   if (finger_shift) *finger_shift = shift;
   return "";

@@ -394,9 +394,9 @@ class FolderSource final : public FrameSource {
   // An image that does not decode is an error. Following, it may still be
   // being written: while its size keeps changing, or for two seconds after
   // it last changed, it is read again (also when it decodes but the decoder
-  // complains, as it does about a half-written JPEG: it is taken once its
-  // size has stayed for those two seconds, with a warning naming it). A
-  // cancel while waiting returns an empty image.
+  // complains, as it does about a half-written JPEG: it is taken once it
+  // has been unchanged for those two seconds, by its size or its file time,
+  // with a warning naming it). A cancel while waiting returns an empty image.
   cv::Mat read(const fs::path& p) const {
     auto changed = std::chrono::steady_clock::now();
     std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
@@ -417,11 +417,15 @@ class FolderSource final : public FrameSource {
         changed = now;
         last_size = size;
       }
-      // Settled: unchanged for 2 s, as seen here or by the file's own time.
+      // Settled: unchanged for 2 s as seen here. An image that decodes, with
+      // a complaint, is also taken once its size held over a poll and its
+      // file time is 2 s old (a finished file that always draws one); its
+      // failure is judged here only, since a file server's clock may run
+      // behind this one.
+      const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0;
       const auto written = fs::last_write_time(p, ec);
-      const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0 ||
-                           (!ec && fs::file_time_type::clock::now() - written > std::chrono::seconds(2));
-      if (!img.empty() && (said.empty() || settled)) {
+      const bool old = !growing && !ec && fs::file_time_type::clock::now() - written > std::chrono::seconds(2);
+      if (!img.empty() && (said.empty() || settled || old)) {
         if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
         return img;
       }
