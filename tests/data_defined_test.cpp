@@ -85,6 +85,21 @@ TEST(DataDefinedGripper, RadialFormAndModelFile) {
   EXPECT_EQ(g2->model().fingers(), 4);
 }
 
+// One [[finger]] table: a single link 0.3 mm long, hinged at (x, y).
+std::string finger_table(double x, double y, double direction_deg) {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "[[finger]]\nbase_mm = [%.2f, %.2f]\ndirection_deg = %g\nlink_lengths_mm = [0.3]\n"
+                "link_widths_mm = [0.2, 0.1]\n",
+                x, y, direction_deg);
+  return text;
+}
+
+// `text` with its first `from` replaced by `to`.
+std::string with(std::string text, const std::string& from, const std::string& to) {
+  return text.replace(text.find(from), from.size(), to);
+}
+
 std::string config_error(const std::string& toml) {
   try {
     make_gripper(toml);
@@ -179,11 +194,8 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
                    "where no finger has its hinge"),
             std::string::npos)
       << e;
-  std::string two_fold = two;
-  two_fold.replace(two_fold.find("symmetry_order = 4"), 18, "symmetry_order = 2");
-  EXPECT_EQ(config_error(two_fold), "");
-  std::string oblong = kFourFinger;
-  oblong.replace(oblong.find("[[0.4, 0.0], [0.0, 0.4]"), 23, "[[0.6, 0.0], [0.0, 0.4]");
+  EXPECT_EQ(config_error(with(two, "symmetry_order = 4", "symmetry_order = 2")), "");
+  const std::string oblong = with(kFourFinger, "[[0.4, 0.0], [0.0, 0.4]", "[[0.6, 0.0], [0.0, 0.4]");
   EXPECT_NE(config_error(oblong).find("takes palm point 1 [0.6, 0] to [0, 0.6], 0.2 mm off the palm's outline"),
             std::string::npos)
       << config_error(oblong);
@@ -193,17 +205,14 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
                                       "whose links differ"),
             std::string::npos)
       << config_error(longer);
-  std::string turned = kFourFinger;
-  turned.replace(turned.find("direction_deg = 135"), 19, "direction_deg = 150");
+  const std::string turned = with(kFourFinger, "direction_deg = 135", "direction_deg = 150");
   EXPECT_NE(config_error(turned).find("takes finger 1: its direction to 135 deg, where finger 2 at its hinge points "
                                       "to 150 deg"),
             std::string::npos)
       << config_error(turned);
   // Hand-typed coordinates of a regular shape are the shape: a few um off,
   // or rounded to 0.01 mm on a palm 0.4 mm across.
-  std::string typed = kFourFinger;
-  typed.replace(typed.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.201, 0.199]");
-  EXPECT_EQ(config_error(typed), "");
+  EXPECT_EQ(config_error(with(kFourFinger, "base_mm = [0.2, 0.2]", "base_mm = [0.201, 0.199]")), "");
   // A round palm of many points, whose turn by a third lands between them
   // (on its outline), with three fingers; its points rounded to 0.01 mm, so
   // that some repeat.
@@ -215,26 +224,14 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
     round += p;
   }
   round += "]\n";
-  for (int f = 0; f < 3; ++f) {
-    char finger[200];
-    std::snprintf(finger, sizeof finger,
-                  "[[finger]]\nbase_mm = [%.2f, %.2f]\ndirection_deg = %d\nlink_lengths_mm = [0.3]\n"
-                  "link_widths_mm = [0.2, 0.1]\n",
-                  0.5 * std::cos(2 * M_PI * f / 3), 0.5 * std::sin(2 * M_PI * f / 3), 120 * f);
-    round += finger;
-  }
+  for (int f = 0; f < 3; ++f) round += finger_table(0.5 * std::cos(2 * M_PI * f / 3), 0.5 * std::sin(2 * M_PI * f / 3), 120 * f);
   EXPECT_EQ(config_error(round), "");
   // Two fingers on one hinge, each side (a V): a half turn takes each onto
   // the one of the other side's pair that points its way.
   std::string vee = "plugin = \"data_defined\"\nsymmetry_order = 2\n"
                     "palm_mm = [[0.45, -0.3], [0.45, 0.3], [-0.45, 0.3], [-0.45, -0.3]]\n";
   for (const auto& [x, d] : std::vector<std::pair<double, int>>{{0.45, 30}, {0.45, -30}, {-0.45, 210}, {-0.45, 150}}) {
-    char finger[200];
-    std::snprintf(finger, sizeof finger,
-                  "[[finger]]\nbase_mm = [%.2f, 0.0]\ndirection_deg = %d\nlink_lengths_mm = [0.3]\n"
-                  "link_widths_mm = [0.2, 0.1]\n",
-                  x, d);
-    vee += finger;
+    vee += finger_table(x, 0, d);
   }
   EXPECT_EQ(config_error(vee), "");
 }
@@ -243,30 +240,10 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
 // to the one its hinge lands on, not to either finger of the opposite
 // direction, so the turned pose has the same joints in other slots.
 TEST(DataDefinedGripper, AHalfTurnOfAForkMapsFingersByTheirHinges) {
-  auto g = make_gripper(R"(plugin = "data_defined"
-palm_mm = [[0.5, -0.4], [0.5, 0.4], [-0.5, 0.4], [-0.5, -0.4]]
-symmetry_order = 2
-[[finger]]
-base_mm = [0.5, 0.2]
-direction_deg = 0
-link_lengths_mm = [0.5, 0.3]
-link_widths_mm = [0.2, 0.15, 0.1]
-[[finger]]
-base_mm = [0.5, -0.2]
-direction_deg = 0
-link_lengths_mm = [0.5, 0.3]
-link_widths_mm = [0.2, 0.15, 0.1]
-[[finger]]
-base_mm = [-0.5, -0.2]
-direction_deg = 180
-link_lengths_mm = [0.5, 0.3]
-link_widths_mm = [0.2, 0.15, 0.1]
-[[finger]]
-base_mm = [-0.5, 0.2]
-direction_deg = 180
-link_lengths_mm = [0.5, 0.3]
-link_widths_mm = [0.2, 0.15, 0.1]
-)");
+  auto g = make_gripper("plugin = \"data_defined\"\nsymmetry_order = 2\n"
+                        "palm_mm = [[0.5, -0.4], [0.5, 0.4], [-0.5, 0.4], [-0.5, -0.4]]\n" +
+                        finger_table(0.5, 0.2, 0) + finger_table(0.5, -0.2, 0) + finger_table(-0.5, -0.2, 180) +
+                        finger_table(-0.5, 0.2, 180));
   const auto& m = g->model();
   Eigen::VectorXd h(10);
   h << 0, 0, 100, 10, 5, 0, 10, 20, 30, 40;

@@ -112,6 +112,17 @@ gtrack::TrackOptions folder_run(const fs::path& dir, int n) {
   return o;
 }
 
+// Options for following the folder `live` (--follow-input idle_s) into
+// dir/out, quietly.
+gtrack::TrackOptions followed_run(const fs::path& live, const fs::path& dir, double idle_s) {
+  gtrack::TrackOptions o;
+  o.input = live.string();
+  o.out_dir = dir / "out";
+  o.progress = false;
+  o.follow_input_s = idle_s;
+  return o;
+}
+
 struct TrackRun {
   gtrack::Setup setup;
   gtrack::EngineConfig config;
@@ -370,13 +381,9 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   const fs::path staged = write_frames(dir / "staged", kFollowed), live = dir / "live";
   fs::create_directories(live);
   const TrackRun r = make_run();
-  gtrack::TrackOptions o;
-  o.input = live.string();
-  o.out_dir = dir / "out";
-  o.progress = false;
   // Generous against a loaded machine (the writer pauses 120 ms per image):
   // the run then waits 3 s after the last one.
-  o.follow_input_s = 3.0;
+  gtrack::TrackOptions o = followed_run(live, dir, 3.0);
   // A jthread: joined even when track_sequence throws, so a failure fails
   // this test instead of ending the whole test program.
   std::jthread writer([&] {
@@ -423,11 +430,7 @@ TEST(Fault, FollowedFolderWaitsOutAHalfWrittenJpegAndNamesALateImage) {
   ref.progress = false;
   gtrack::track_sequence(r.setup, r.config, ref);
 
-  gtrack::TrackOptions o;
-  o.input = live.string();
-  o.out_dir = dir / "out";
-  o.progress = false;
-  o.follow_input_s = 3.0;
+  const gtrack::TrackOptions o = followed_run(live, dir, 3.0);
   std::ostringstream log;
   gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
   std::jthread writer([&] {
@@ -474,11 +477,7 @@ TEST(Fault, ACancelWhileFollowingEndsTheRunAsCancelled) {
       std::ofstream(live / "000001.png", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
     }
     const TrackRun r = make_run();
-    gtrack::TrackOptions o;
-    o.input = live.string();
-    o.out_dir = dir / "out";
-    o.progress = false;
-    o.follow_input_s = 60.0;
+    gtrack::TrackOptions o = followed_run(live, dir, 60.0);
     std::atomic<bool> cancel{false};
     o.cancel = &cancel;
     std::jthread stopper([&] {
