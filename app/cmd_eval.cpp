@@ -161,8 +161,11 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     if (!fs::exists(f)) throw gtrack::InputError(f.string() + ": no such file");  // a pipe is read
   }
   // Where the results go is checked before anything is computed.
+  gtrack::cli::NamedPaths outputs;
   for (const char* key : {"json", "per-frame"}) {
-    if (vm.count(key)) gtrack::cli::check_output_folder(vm[key].as<std::string>(), key);
+    if (!vm.count(key)) continue;
+    gtrack::cli::check_output_folder(vm[key].as<std::string>(), key);
+    outputs.emplace_back(std::string("--") + key, vm[key].as<std::string>());
   }
   // The model comes from a config: the one given, or the sequence.toml that
   // 'gtrack synth' wrote next to its ground truth.
@@ -171,10 +174,6 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   if (!fs::exists(config)) {
     throw gtrack::cli::UsageError("no --config given and no " + config.string() +
                                   " next to the truth; the config names the gripper model");
-  }
-  gtrack::cli::NamedPaths outputs;
-  for (const char* key : {"json", "per-frame"}) {
-    if (vm.count(key)) outputs.emplace_back(std::string("--") + key, vm[key].as<std::string>());
   }
   gtrack::cli::check_outputs_apart(outputs,
                                    {{"--truth", truth_file}, {"--estimates", estimates_file}, {"config", config}});

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "command.hpp"
+#include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/plugin_loader.hpp"
@@ -38,23 +39,20 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   // one of the look the config segments (grey levels for luminance, as an
   // ultrasound slice's default is; colour otherwise), so that the frames
   // are ones the config can track.
-  const std::string sensor_look = setup.sensor->segmentation_defaults().color_space;
-  const std::string look = setup.root.table("observation")
-                               .choice_or("color_space", sensor_look == "luminance" ? sensor_look : "hsv",
-                                          {"hsv", "luminance"});
+  const bool grey_look = gtrack::observation_color_space(setup.root.table("observation"), *setup.sensor) == "luminance";
   const auto grey = [](const gtrack::SynthPreset& p) { return p.gripper_hsv[1] == 0; };
   if (vm.count("config") && vm["preset"].defaulted()) {
     const auto& all = gtrack::synth_presets();
     const auto same = std::find_if(all.begin(), all.end(), [&](const auto& p) {
-      return p.config == config.filename() && grey(p) == (look == "luminance");
+      return p.config == config.filename() && grey(p) == grey_look;
     });
-    o.preset = same != all.end() ? same->name : look == "luminance" ? "ultrasound" : "microscope";
+    o.preset = same != all.end() ? same->name : grey_look ? "ultrasound" : "microscope";
   }
-  if (grey(gtrack::synth_preset(o.preset)) != (look == "luminance")) {
+  if (const bool grey_frames = grey(gtrack::synth_preset(o.preset)); grey_frames != grey_look) {
     gtrack::logger().warn("--preset {} draws {} frames, but {} segments {}: its config will not find the "
                           "gripper in them (leave --preset out to take one it can)",
-                          o.preset, grey(gtrack::synth_preset(o.preset)) ? "grey-level" : "colour", config.string(),
-                          look == "luminance" ? "grey levels" : "colour");
+                          o.preset, grey_frames ? "grey-level" : "colour", config.string(),
+                          grey_look ? "grey levels" : "colour");
   }
   const std::filesystem::path out = vm["out"].as<std::string>();
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);

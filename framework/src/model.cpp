@@ -71,6 +71,17 @@ std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> p) {
   return hull;
 }
 
+// Twice the signed area of a closed polygon (the shoelace sum): positive
+// when its points run counter-clockwise.
+double twice_area(const std::vector<Eigen::Vector2d>& polygon) {
+  double a = 0;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d &p = polygon[i], &q = polygon[(i + 1) % polygon.size()];
+    a += p.x() * q.y() - p.y() * q.x();
+  }
+  return a;
+}
+
 // Distance from p to the closed polygon's outline.
 double distance_to_outline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon) {
   double d = std::numeric_limits<double>::infinity();
@@ -94,11 +105,9 @@ std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& points) {
   }
   while (palm.size() > 1 && (palm.front() - palm.back()).norm() <= 1e-12) palm.pop_back();
   const size_t n = palm.size();
-  double area = 0, size = 0;
-  for (size_t i = 0; i < n; ++i) {
-    area += palm[i].x() * palm[(i + 1) % n].y() - palm[i].y() * palm[(i + 1) % n].x();
-    size = std::max(size, palm[i].norm());
-  }
+  const double area = twice_area(palm);
+  double size = 0;
+  for (const auto& p : palm) size = std::max(size, p.norm());
   if (n < 3 || !(area > 0)) {
     return area < 0 ? "the palm polygon's points run clockwise; expected them counter-clockwise, around a convex polygon"
                     : "the palm polygon has no area; expected a convex polygon, its points counter-clockwise";
@@ -121,11 +130,7 @@ std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& points) {
   // Once around, in the hull's order: a polygon that crosses itself turns
   // other than once around (a bowtie not at all, a pentagram twice), or
   // covers less than its hull.
-  double hull_area = 0;
-  for (size_t i = 0; i < hull.size(); ++i) {
-    hull_area += hull[i].x() * hull[(i + 1) % hull.size()].y() - hull[i].y() * hull[(i + 1) % hull.size()].x();
-  }
-  if (std::abs(turned - 2 * std::numbers::pi) > 1e-6 || area < 0.9 * hull_area) {
+  if (std::abs(turned - 2 * std::numbers::pi) > 1e-6 || area < 0.9 * twice_area(hull)) {
     return "the palm polygon crosses itself (its outline does not go once around, in order); expected a convex "
            "polygon, its points counter-clockwise";
   }
@@ -188,12 +193,12 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
     const FingerShape& a = G.fingers[f];
     const Eigen::Vector2d base = turned(a.base_mm);
     const double direction = a.direction_deg + step;
+    const auto hinge_apart = [&](int g) { return (G.fingers[g].base_mm - base).norm(); };
+    const auto turned_apart = [&](int g) { return std::abs(std::remainder(direction - G.fingers[g].direction_deg, 360.0)); };
     // The finger it lands on: at the turned hinge, in the turned direction,
     // with the same links, not yet landed on.
     const auto lands_on = [&](int g) {
-      const FingerShape& b = G.fingers[g];
-      return !taken[g] && (b.base_mm - base).norm() <= tol &&
-             std::abs(std::remainder(direction - b.direction_deg, 360.0)) <= 1.0 && same_links(a, b);
+      return !taken[g] && hinge_apart(g) <= tol && turned_apart(g) <= 1.0 && same_links(a, G.fingers[g]);
     };
     int target = -1;
     for (int g = 0; g < F && target < 0; ++g) {
@@ -203,14 +208,14 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
       // Why not, said of the finger nearest the turned hinge.
       int nearest = 0;
       for (int g = 1; g < F; ++g) {
-        if ((G.fingers[g].base_mm - base).norm() < (G.fingers[nearest].base_mm - base).norm()) nearest = g;
+        if (hinge_apart(g) < hinge_apart(nearest)) nearest = g;
       }
       const FingerShape& b = G.fingers[nearest];
       std::string why;
-      if ((b.base_mm - base).norm() > tol) {
+      if (hinge_apart(nearest) > tol) {
         why = "its hinge to " + point(base) + ", where no finger has its hinge (nearest: finger " +
               std::to_string(nearest + 1) + " at " + point(b.base_mm) + ")";
-      } else if (std::abs(std::remainder(direction - b.direction_deg, 360.0)) > 1.0) {
+      } else if (turned_apart(nearest) > 1.0) {
         char text[128];
         std::snprintf(text, sizeof text, "its direction to %g deg, where finger %d at its hinge points to %g deg",
                       shown(std::remainder(direction, 360.0)), nearest + 1, b.direction_deg);

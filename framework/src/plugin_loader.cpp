@@ -277,8 +277,9 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
     throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
                       "): factory returned nothing");
   }
-  // The deleter owns the library: the instance is destroyed while its code
-  // is still mapped, and the library goes only after its last instance.
+  // The deleter owns the library as well (keep_loaded's hold ends with the
+  // process's static objects): the instance is destroyed while its code is
+  // still mapped, whenever that is.
   std::shared_ptr<Interface> instance(raw, [lib](Interface* p) { delete p; });
   keep_loaded(lib, file);
   table.check_all_used();

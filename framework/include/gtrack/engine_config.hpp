@@ -190,6 +190,12 @@ struct EngineConfig {
 // key of those tables, marks them used on the root. Throws ConfigError.
 GTRACK_API EngineConfig engine_config(const Setup& setup);
 
+// [observation] color_space: "hsv" or "luminance", by default the sensor's
+// (hsv unless it says luminance). `gtrack synth` draws frames of that look.
+GTRACK_API std::string observation_color_space(const ConfigTable& observation, const Sensor& sensor);
+// [tracker] fps: 0 (the source's rate) or a rate from 0.001 to 10^6 frames/s.
+GTRACK_API double tracker_fps(const ConfigTable& tracker);
+
 // After engine_config(): every root key that neither the plugins nor the
 // engine read is an error (e.g. a misspelled table name).
 GTRACK_API void check_root_keys(const Setup& setup);

@@ -14,6 +14,7 @@
 #include <random>
 #include <sstream>
 
+#include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
 #include "gtrack/model.hpp"
@@ -149,10 +150,7 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   plan.options = options;
   apply_synth_table(plan.preset, setup.root.table("synth"));
   // The config's camera rate, when it gives one, is the sequence's.
-  const ConfigTable tracker = setup.root.table("tracker");
-  const double config_fps = tracker.number_or("fps", 0.0, Range::closed(0, 1e6));
-  if (config_fps > 0 && config_fps < 1e-3) tracker.fail("fps", "expected 0 or a rate of at least 0.001 frames/s");
-  if (config_fps > 0) plan.preset.frame_rate_hz = config_fps;
+  if (const double fps = tracker_fps(setup.root.table("tracker")); fps > 0) plan.preset.frame_rate_hz = fps;
   const SynthPreset& p = plan.preset;
   const ArticulatedModel& model = setup.model();
   const Sensor& sensor = *setup.sensor;

@@ -21,9 +21,7 @@ const std::vector<std::string> kOtherTables = {"synth", "sweep", "bench", "demo"
 
 ObservationConfig read_observation(const ConfigTable& t, const Sensor& sensor) {
   ObservationConfig o;
-  std::string dflt = sensor.segmentation_defaults().color_space;
-  if (dflt != "hsv" && dflt != "luminance") dflt = "hsv";
-  o.color_space = t.choice_or("color_space", dflt, {"hsv", "luminance"});
+  o.color_space = observation_color_space(t, sensor);
   const Range hue = Range::closed(0, 180), byte = Range::closed(0, 255);
   o.hue_min = t.number_or("hue_min", o.hue_min, hue);
   o.hue_max = t.number_or("hue_max", o.hue_max, hue);
@@ -152,7 +150,8 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
   // bounds (+-90 deg by default) keep the palm facing +z, and the tilt mirror
   // is taken about z. A sensor that looks along another axis sees the
   // gripper face on only at the bounds.
-  const Eigen::Vector3d axis = viewing_axis(sensor.projection());
+  const Projection projection = sensor.projection();
+  const Eigen::Vector3d axis = viewing_axis(projection);
   const double off_z = std::acos(std::min(1.0, std::abs(axis.z()))) * 180 / std::numbers::pi;
   if (off_z > 30) {
     logger().warn("{}: the [sensor] looks along {}, {:.0f} deg from world z, but the tracker's orientation is taken about "
@@ -161,7 +160,7 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
                   "ultrasound_slice: probe_rotation_deg = [0, 0, 0]) and turn the estimates afterwards",
                   t.source(), vec_text(axis), off_z);
   }
-  if (!box_meets_view(sensor.projection(), s.position_min_mm.array() - radius, s.position_max_mm.array() + radius)) {
+  if (!box_meets_view(projection, s.position_min_mm.array() - radius, s.position_max_mm.array() + radius)) {
     t.fail("position_min_mm", "the box up to position_max_mm lies wholly outside the sensor's view, the model's "
                               "radius included, so no gripper in it can be seen; expected a box about the field of "
                               "view, such as the default around " +
@@ -190,10 +189,7 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
     if (!space.contains(h)) t.fail("initial_pose", "lies outside the [search] bounds or the joint limits");
     c.initial_pose = h;
   }
-  // 0: the source's own rate. Microscope and ultrasound cameras run from a
-  // frame a minute to a few hundred thousand a second.
-  c.fps = t.number_or("fps", c.fps, Range::closed(0, 1e6));
-  if (c.fps > 0 && c.fps < 1e-3) t.fail("fps", "expected 0 (the source's rate) or a rate of at least 0.001 frames/s");
+  c.fps = tracker_fps(t);
   c.image_bits = static_cast<int>(t.integer_or("image_bits", c.image_bits, Range::closed(8, 16)));
   if (t.has("default_stimulus")) c.default_stimulus = t.number("default_stimulus", Range::closed(-1e9, 1e9));
   c.lost_dice = t.number_or("lost_dice", c.lost_dice, {0.0, 1.0, true, false});
@@ -219,6 +215,19 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
 }
 
 }  // namespace
+
+std::string observation_color_space(const ConfigTable& observation, const Sensor& sensor) {
+  const std::string dflt = sensor.segmentation_defaults().color_space == "luminance" ? "luminance" : "hsv";
+  return observation.choice_or("color_space", dflt, {"hsv", "luminance"});
+}
+
+double tracker_fps(const ConfigTable& tracker) {
+  // 0: the source's own rate. Microscope and ultrasound cameras run from a
+  // frame a minute to a few hundred thousand a second.
+  const double fps = tracker.number_or("fps", TrackerConfig{}.fps, Range::closed(0, 1e6));
+  if (fps > 0 && fps < 1e-3) tracker.fail("fps", "expected 0 (the source's rate) or a rate of at least 0.001 frames/s");
+  return fps;
+}
 
 EngineConfig engine_config(const Setup& setup) {
   const ConfigTable& root = setup.root;
