@@ -18,7 +18,9 @@
 
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/evaluation.hpp"
 #include "gtrack/model.hpp"
+#include "gtrack/synth.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/tracker_state.hpp"
 
@@ -323,6 +325,54 @@ TEST(Tracker, NothingDetectedIsLostNotAnError) {
 // `initial_pose` starts the first frame that shows the gripper, also when
 // frames before it showed nothing: the track starts there (status tracked),
 // not from a coarse search.
+// The tracker searches in the sensor's own frame: a probe turned in the
+// world (looking down world -z, its slice the world's x-z plane) that sees
+// the images an upright probe sees gives the upright probe's estimates,
+// turned with it, and scores them as it does. Searched in the world's
+// frame, its tilts were taken about the wrong axes (60 deg off on average).
+TEST(Tracker, ATurnedProbeIsTrackedAsTheUprightOne) {
+  const std::string upright_text =
+      "[sensor]\nplugin = \"ultrasound_slice\"\n[gripper]\nplugin = \"hydrogel_six_finger\"\n"
+      "[stimulus]\nplugin = \"temperature_hysteresis\"\n[render]\nbackend = \"cpu\"\nthreads = 2\n";
+  std::string turned_text = upright_text;
+  turned_text.insert(turned_text.find("[gripper]"), "probe_rotation_deg = [-90, 0, 0]\n");
+  const auto upright = gtrack::load_setup(gtrack::ConfigTable::parse(upright_text, "u.toml"), {});
+  const auto turned = gtrack::load_setup(gtrack::ConfigTable::parse(turned_text, "t.toml"), {});
+  const gtrack::SensorFrame frame = gtrack::sensor_frame(*turned.sensor);
+  ASSERT_TRUE(gtrack::sensor_frame(*upright.sensor).is_world());
+  ASSERT_LT((frame.axes * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitY()).norm(), 1e-12);
+  gtrack::SynthOptions o;
+  o.frames = 8;
+  o.seed = 3;
+  o.preset = "ultrasound";
+  const auto plan_u = gtrack::plan_sequence(upright, o), plan_t = gtrack::plan_sequence(turned, o);
+  gtrack::Tracker tu(upright, gtrack::engine_config(upright)), tt(turned, gtrack::engine_config(turned));
+  // The upright probe's configurations as the turned probe sees them.
+  const Eigen::Vector3d shift = turned.sensor->nominal_position_mm() - upright.sensor->nominal_position_mm();
+  const auto as_turned = [&](Eigen::VectorXd h) {
+    h.head<3>() += shift;
+    return frame.to_world(h);
+  };
+  for (int i = 0; i < o.frames; ++i) {
+    const cv::Mat image_u = gtrack::render_frame(upright, plan_u, i, nullptr);
+    const cv::Mat image_t = gtrack::render_frame(turned, plan_t, i, nullptr);
+    ASSERT_EQ(cv::norm(image_u, image_t, cv::NORM_INF), 0) << "frame " << i;
+    const auto eu = tu.process(image_u, i, plan_u.frames[i].time_s, plan_u.frames[i].stimulus);
+    const auto et = tt.process(image_t, i, plan_t.frames[i].time_s, plan_t.frames[i].stimulus);
+    const Eigen::VectorXd expected = as_turned(eu.hypothesis);
+    EXPECT_LT((et.hypothesis.head<3>() - expected.head<3>()).norm(), 1e-3) << "frame " << i;
+    EXPECT_LT(gtrack::geodesic_angle_deg(et.hypothesis.segment<3>(3), expected.segment<3>(3)), 0.1) << "frame " << i;
+    EXPECT_LT((et.hypothesis.tail(6) - eu.hypothesis.tail(6)).cwiseAbs().maxCoeff(), 0.1) << "frame " << i;
+    // The public functions take the world's configurations.
+    EXPECT_NEAR(tt.score(et.hypothesis).total, et.terms.total, 1e-6) << "frame " << i;
+    EXPECT_NEAR(tt.score(as_turned(plan_u.frames[i].truth)).total, tu.score(plan_u.frames[i].truth).total, 1e-6)
+        << "frame " << i;
+    const Eigen::VectorXd last_u = as_turned(*tu.last_estimate()), last_t = *tt.last_estimate();
+    EXPECT_LT((last_t.head<3>() - last_u.head<3>()).norm(), 1e-3) << "frame " << i;
+    EXPECT_LT(gtrack::geodesic_angle_deg(last_t.segment<3>(3), last_u.segment<3>(3)), 0.1) << "frame " << i;
+  }
+}
+
 TEST(Tracker, InitialPoseOutlastsEmptyFirstFrames) {
   auto setup = make_setup("[tracker]\ninitial_pose = [0.1, 0.1, 100.0, 8, -6, 10, 10, 10, 10, 10, 10, 10]\n");
   gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
@@ -875,7 +925,7 @@ TEST(Tracker, UnseenFingersTakeTheSeenFingersFold) {
   EXPECT_LT(joint_error(on.hypothesis), joint_error(off.hypothesis) - 1.0) << on.hypothesis.transpose();
   // The fill changes joints only, costs at most the tolerance, and the track
   // goes on from the search's own result: the same as without the fill.
-  const Eigen::VectorXd& state = *on_tracker->last_estimate();
+  const Eigen::VectorXd state = *on_tracker->last_estimate();
   EXPECT_EQ(state, off.hypothesis);
   EXPECT_EQ(on.hypothesis.head<6>(), state.head<6>());
   EXPECT_NE(on.hypothesis.tail(6), state.tail(6));
@@ -987,6 +1037,35 @@ TEST(EngineConfig, TheRimIsAWholeNumberOfPixels) {
 TEST(EngineConfig, InitialPoseMustHaveEveryParameter) {
   auto setup = make_setup("[tracker]\ninitial_pose = [0.0, 0.0, 100.0]\n");
   EXPECT_THROW(gtrack::engine_config(setup), gtrack::ConfigError);
+}
+
+// For a sensor turned in the world, [search] positions and initial_pose are
+// read in the world and taken into the sensor's frame, where the tracker
+// searches: the box becomes the box about its corners there.
+TEST(EngineConfig, ATurnedSensorsBoxAndInitialPoseAreTakenIntoItsFrame) {
+  const std::string text =
+      "[sensor]\nplugin = \"ultrasound_slice\"\nprobe_rotation_deg = [-90, 0, 0]\n[gripper]\nplugin = "
+      "\"hydrogel_six_finger\"\n[stimulus]\nplugin = \"temperature_hysteresis\"\n[search]\n"
+      "position_min_mm = [-1.0, -2.0, -30.0]\nposition_max_mm = [1.0, 2.0, -20.0]\n[tracker]\n"
+      "initial_pose = [0.5, 1.0, -25.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n";
+  const auto setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "t.toml"), {});
+  const auto config = gtrack::engine_config(setup);
+  const gtrack::SensorFrame frame = gtrack::sensor_frame(*setup.sensor);
+  ASSERT_FALSE(frame.is_world());
+  // The box's extents along the probe's lateral, depth and elevation axes:
+  // world x, -z and y.
+  const Eigen::Vector3d extent = config.space.upper.head<3>() - config.space.lower.head<3>();
+  EXPECT_LT((extent - Eigen::Vector3d(2, 10, 4)).norm(), 1e-9);
+  for (int corner = 0; corner < 8; ++corner) {
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(12);
+    h.head<3>() << ((corner & 1) ? 1.0 : -1.0), ((corner & 2) ? 2.0 : -2.0), ((corner & 4) ? -20.0 : -30.0);
+    EXPECT_TRUE(config.space.contains(frame.from_world(h))) << "corner " << corner;
+  }
+  Eigen::VectorXd pose = Eigen::VectorXd::Zero(12);
+  pose.head<3>() << 0.5, 1.0, -25.0;
+  ASSERT_TRUE(config.tracker.initial_pose);
+  EXPECT_LT((*config.tracker.initial_pose - frame.from_world(pose)).norm(), 1e-9);
+  EXPECT_LT((frame.to_world(*config.tracker.initial_pose) - pose).norm(), 1e-9);
 }
 
 }  // namespace

@@ -115,6 +115,11 @@ struct CostWeights {
   int occlusion_rim_px = 3;
 };
 
+// The search's bounds, like the hypotheses the tracker searches and
+// TrackerConfig::initial_pose, are in the sensor's own frame (SensorFrame in
+// sensor.hpp: rx, ry tilt away from face-on, rz turns about the line of
+// sight), which for a sensor looking down world z is the world's. The config
+// gives positions in the world, angles in the sensor's frame.
 struct SearchConfig {
   Eigen::Vector3d position_min_mm{0, 0, 0}, position_max_mm{0, 0, 0};
   Eigen::Vector3d rotation_min_deg{-90, -90, -180}, rotation_max_deg{90, 90, 180};

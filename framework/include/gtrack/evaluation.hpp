@@ -52,7 +52,10 @@ struct FrameErrors {
   // for a camera looking down world z.
   double position_um = 0, inplane_um = 0, depth_um = 0;
   double orientation_deg = 0;
-  Eigen::Vector3d axis_deg{0, 0, 0};  // |Euler angle differences| about x, y, z
+  // |Euler angle differences| about x, y, z: the sensor's own axes when
+  // evaluate() has the sensor (SensorFrame; the world's for one looking
+  // down z), else the world's.
+  Eigen::Vector3d axis_deg{0, 0, 0};
   double joint_deg = 0;
   double endpoint_um = 0;
   int symmetry_k = 0;  // the equivalent of the estimate that was compared
@@ -85,9 +88,6 @@ GTRACK_API FrameErrors compare_to_truth(const ArticulatedModel& model, const Eig
                                         const Eigen::VectorXd& estimate,
                                         const Eigen::Vector3d& line_of_sight = Eigen::Vector3d::UnitZ(),
                                         const Eigen::Vector3d& viewing_axis = Eigen::Vector3d::UnitZ());
-// The sensor's viewing axis (unit length): a camera's optical axis, the
-// normal of an orthographic view or an ultrasound slice.
-GTRACK_API Eigen::Vector3d viewing_axis(const Projection& projection);
 // The line of sight of `projection` through the image of `world_mm` (unit
 // length; the optical ray of a camera, the plane's normal of a slice).
 GTRACK_API Eigen::Vector3d line_of_sight(const Projection& projection, const Eigen::Vector3d& world_mm);

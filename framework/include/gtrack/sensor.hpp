@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -58,5 +59,34 @@ class GTRACK_API Sensor {
   // Millimetres per pixel at the nominal position (for metrics and presets).
   virtual double mm_per_pixel() const = 0;
 };
+
+// The sensor's viewing axis (unit length): a camera's optical axis, the
+// normal of an orthographic view or an ultrasound slice.
+GTRACK_API Eigen::Vector3d viewing_axis(const Projection& projection);
+
+// A sensor's own frame: axes whose columns are the image's u direction, the
+// direction normal to it within the image, and the viewing axis (unit,
+// right-handed), turning about `origin`, the nominal position. A point p
+// given in the frame is origin + axes * (p - origin) in the world. For a
+// sensor that looks down world z with u along x the frame is the world's.
+//
+// The tracker searches in it, so that rx, ry are tilts away from face-on
+// and rz is a turn about the line of sight whichever way the sensor is
+// turned in the world; what it reads and writes stays in the world.
+struct GTRACK_API SensorFrame {
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+
+  bool is_world() const;
+  // A configuration x, y, z, rx, ry, rz, q.. given in this frame, in the
+  // world (joints unchanged), and back.
+  Eigen::VectorXd to_world(const Eigen::VectorXd& h) const;
+  Eigen::VectorXd from_world(const Eigen::VectorXd& h) const;
+};
+
+GTRACK_API SensorFrame sensor_frame(const Sensor& sensor);
+// The sensor seen from `frame`: its projection, clip planes, project() and
+// nominal position take and give points in the frame.
+GTRACK_API std::shared_ptr<Sensor> sensor_in_frame(std::shared_ptr<const Sensor> sensor, const SensorFrame& frame);
 
 }  // namespace gtrack

@@ -93,6 +93,11 @@ struct Estimate {
 // One Tracker follows one sequence. It keeps the Setup's plugin instances
 // (shared pointers): process() feeds the Setup's Stimulus, so two trackers
 // running at once need a Setup each.
+//
+// The configurations it takes and gives are in the world. It searches in
+// the sensor's own frame (SensorFrame in sensor.hpp), as its config's space
+// is, so that a probe or a camera turned in the world is tracked as an
+// upright one; for a sensor that looks down world z the two are the same.
 class GTRACK_API Tracker {
  public:
   // Makes the renderer named by config.render.
@@ -110,6 +115,7 @@ class GTRACK_API Tracker {
 
   // Forget the history: the next frame starts like the first.
   void reset();
+  // The history, in the frame the tracker searches in (see below).
   TrackerState state() const;
   // Continue from a state (of a tracker with the same setup and config);
   // gtrack::Error when its configurations are not of this setup's size.
@@ -119,7 +125,7 @@ class GTRACK_API Tracker {
   void replay_stimulus(std::optional<double> stimulus, double time_s);
   // Start the next frame from this hypothesis (as if it were the last estimate).
   void set_estimate(const Eigen::VectorXd& hypothesis);
-  const std::optional<Eigen::VectorXd>& last_estimate() const;
+  std::optional<Eigen::VectorXd> last_estimate() const;
 
   // The observation of the last processed frame (render size, 0/255).
   const Observation& last_observation() const;

@@ -74,6 +74,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   const bool dims_match = estimates.fingers == model.fingers();
   const std::optional<Projection> projection = sensor ? std::optional<Projection>(sensor->projection()) : std::nullopt;
   const Eigen::Vector3d axis = projection ? viewing_axis(*projection) : Eigen::Vector3d::UnitZ();
+  const SensorFrame frame = sensor ? sensor_frame(*sensor) : SensorFrame{};
   std::vector<double> unmirrored;  // orientation errors of in-view frames that are no tilt mirror
   double mirrored_sum = 0, branch_sum = 0, orientation_sum = 0;
 
@@ -101,7 +102,11 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
     } else {
       const Eigen::Vector3d sight =
           projection ? line_of_sight(*projection, t.h.head<3>()) : Eigen::Vector3d::UnitZ();
-      fe.errors = compare_to_truth(model, t.h, it->second->h, sight, axis);
+      // Compared in the sensor's own frame, so that the per-axis errors are
+      // about the image's axes and the line of sight (the others do not
+      // depend on the frame).
+      fe.errors = compare_to_truth(model, frame.from_world(t.h), frame.from_world(it->second->h),
+                                   frame.axes.transpose() * sight, frame.axes.transpose() * axis);
       if (fe.out_of_view) {
         ev.out_of_view.add(fe.errors);
       } else {

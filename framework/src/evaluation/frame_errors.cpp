@@ -66,15 +66,6 @@ Eigen::Vector3d line_of_sight(const Projection& projection, const Eigen::Vector3
   return d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::UnitZ();
 }
 
-Eigen::Vector3d viewing_axis(const Projection& projection) {
-  // P = [M | p4]: a camera's principal ray runs along M's third row; an
-  // affine view (third row zero) looks along what neither image axis sees.
-  const Eigen::Matrix3d m = projection.world_to_image.leftCols<3>();
-  Eigen::Vector3d axis = m.row(2).transpose();
-  if (axis.norm() == 0) axis = m.row(0).transpose().cross(m.row(1).transpose());
-  return axis.norm() > 0 ? Eigen::Vector3d(axis.normalized()) : Eigen::Vector3d::UnitZ();
-}
-
 FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorXd& truth,
                              const Eigen::VectorXd& estimate, const Eigen::Vector3d& line_of_sight,
                              const Eigen::Vector3d& viewing_axis) {

@@ -16,7 +16,6 @@
 
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
-#include "gtrack/evaluation.hpp"
 #include "gtrack/model.hpp"
 #include "gtrack/synth.hpp"
 #include "synth/smooth_path.hpp"
@@ -123,21 +122,6 @@ void apply_synth_table(SynthPreset& p, const ConfigTable& t) {
   }
 }
 
-// The sensor's frame in the world: its columns the image's u and v
-// directions and the viewing axis. Motion and tilts are planned in it, so
-// that a probe or a camera turned in the world sees the sequence an upright
-// one does; the identity for sensors that look down world z with u along x.
-Eigen::Matrix3d sensor_frame(const Projection& p) {
-  const Eigen::Vector3d e3 = viewing_axis(p);
-  const Eigen::Vector3d m1 = p.world_to_image.block<1, 3>(0, 0).transpose();
-  Eigen::Vector3d e1 = m1 - m1.dot(e3) * e3;
-  if (!(e1.norm() > 0)) return Eigen::Matrix3d::Identity();
-  e1.normalize();
-  Eigen::Matrix3d f;
-  f << e1, e3.cross(e1), e3;
-  return f;
-}
-
 }  // namespace
 
 SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
@@ -163,8 +147,9 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   for (int i = 0; i < n; ++i) times[i] = i / fps;
 
   const Eigen::Vector3d nominal = sensor.nominal_position_mm();
-  const Eigen::Matrix3d frame = sensor_frame(sensor.projection());
-  const bool upright = (frame - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12;
+  // Motion and tilts are planned in the sensor's own frame, so that a probe
+  // or a camera turned in the world sees the sequence an upright one does.
+  const SensorFrame frame = sensor_frame(sensor);
   const double mmpp = sensor.mm_per_pixel(), radius = model.radius_mm();
   const ImageSize size = sensor.image_size();
   const Eigen::Vector2d half_view(0.5 * size.width * mmpp, 0.5 * size.height * mmpp);
@@ -216,12 +201,7 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
     h[4] = ramp * p.tilt_amplitude_deg * pry[i];
     double rz = rz0 + spin_sign * p.spin_deg_per_s * t + 0.25 * p.spin_deg_per_s * p.motion_period_s * prz[i];
     h[5] = std::remainder(rz, 360.0);
-    if (!upright) {
-      // Planned in the sensor's frame about the nominal position.
-      const Eigen::Vector3d offset = h.head<3>() - nominal;
-      h.head<3>() = nominal + frame * offset;
-      h.segment<3>(3) = euler_deg_from_rotation(frame * rotation_from_euler_deg(h[3], h[4], h[5]));
-    }
+    h = frame.to_world(h);
 
     stimulus->update(temperature[i], t);
     if (i > 0) {

@@ -4,11 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
+#include <limits>
 
 #include "gtrack/error.hpp"
-#include "gtrack/evaluation.hpp"
-#include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
 
 namespace gtrack {
@@ -146,30 +144,35 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
     if (!(s.position_min_mm[i] < s.position_max_mm[i])) t.fail("position_min_mm", "must be below position_max_mm");
     if (!(s.rotation_min_deg[i] < s.rotation_max_deg[i])) t.fail("rotation_min_deg", "must be below rotation_max_deg");
   }
-  // The orientation's parameters are about world z: rx, ry within the
-  // bounds (+-90 deg by default) keep the palm facing +z, and the tilt mirror
-  // is taken about z. A sensor that looks along another axis sees the
-  // gripper face on only at the bounds.
   const Projection projection = sensor.projection();
-  const Eigen::Vector3d axis = viewing_axis(projection);
-  const double off_z = std::acos(std::min(1.0, std::abs(axis.z()))) * 180 / std::numbers::pi;
-  if (off_z > 30) {
-    logger().warn("{}: the [sensor] looks along {}, {:.0f} deg from world z, but the tracker's orientation is taken about "
-                  "world z (rx, ry within [search] rotation_min_deg..rotation_max_deg, the tilt mirror about z): "
-                  "tilted grippers will be found at the bounds or upside down. Track in the sensor's own frame (for "
-                  "ultrasound_slice: probe_rotation_deg = [0, 0, 0]) and turn the estimates afterwards",
-                  t.source(), vec_text(axis), off_z);
-  }
   if (!box_meets_view(projection, s.position_min_mm.array() - radius, s.position_max_mm.array() + radius)) {
     t.fail("position_min_mm", "the box up to position_max_mm lies wholly outside the sensor's view, the model's "
                               "radius included, so no gripper in it can be seen; expected a box about the field of "
                               "view, such as the default around " +
                                   vec_text(sensor.nominal_position_mm()) + " mm");
   }
+  // The search runs in the sensor's own frame (SensorFrame), which turns
+  // about the nominal position: the default box is the same cube there; a
+  // box given in the world is taken as the box about its corners there.
+  const SensorFrame frame = sensor_frame(sensor);
+  if (!frame.is_world() && (t.has("position_min_mm") || t.has("position_max_mm"))) {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c((corner & 1) ? s.position_max_mm.x() : s.position_min_mm.x(),
+                              (corner & 2) ? s.position_max_mm.y() : s.position_min_mm.y(),
+                              (corner & 4) ? s.position_max_mm.z() : s.position_min_mm.z());
+      const Eigen::Vector3d in_frame = frame.origin + frame.axes.transpose() * (c - frame.origin);
+      lo = lo.cwiseMin(in_frame);
+      hi = hi.cwiseMax(in_frame);
+    }
+    s.position_min_mm = lo;
+    s.position_max_mm = hi;
+  }
   return s;
 }
 
-TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, const ParameterSpace& space) {
+TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, const ParameterSpace& space,
+                           const SensorFrame& frame) {
   TrackerConfig c;
   const double r = model.radius_mm();
   // Depth is the weakly observed direction (near-orthographic views): a
@@ -185,7 +188,7 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
                                  " values x,y,z (mm), rx,ry,rz (deg), q1..qF (deg), got " +
                                  std::to_string(pose.size()));
     }
-    Eigen::VectorXd h = Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims());
+    const Eigen::VectorXd h = frame.from_world(Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims()));
     if (!space.contains(h)) t.fail("initial_pose", "lies outside the [search] bounds or the joint limits");
     c.initial_pose = h;
   }
@@ -265,7 +268,7 @@ EngineConfig engine_config(const Setup& setup) {
                                  g.joint_max_deg, full_turn);
   {
     const ConfigTable t = root.table("tracker");
-    e.tracker = read_tracker(t, model, e.space);
+    e.tracker = read_tracker(t, model, e.space, sensor_frame(*setup.sensor));
     t.check_all_used();
   }
   return e;

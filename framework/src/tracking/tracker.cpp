@@ -38,7 +38,13 @@ const char* to_string(TrackStatus status) {
 }
 
 struct Tracker::Impl {
+  // The setup with its sensor seen from the sensor's own frame, in which
+  // every configuration below is: the public functions turn what they take
+  // and give into the world (SensorFrame, the identity for a sensor that
+  // looks down world z).
   Setup setup;
+  SensorFrame frame;
+  std::shared_ptr<Sensor> world_sensor;  // for drawing the world's configurations
   EngineConfig config;
   std::unique_ptr<Renderer> renderer;
   // The occlusion budget's reference: the model rendered on a canvas that
@@ -75,6 +81,9 @@ struct Tracker::Impl {
   Impl(const Setup& s, EngineConfig c, std::unique_ptr<Renderer> r)
       : setup(s), config(std::move(c)), renderer(std::move(r)) {
     if (!setup.sensor || !setup.gripper) throw Error("tracker: the setup has no sensor or gripper");
+    world_sensor = setup.sensor;
+    frame = sensor_frame(*setup.sensor);
+    if (!frame.is_world()) setup.sensor = sensor_in_frame(setup.sensor, frame);
     renderer->set_model(setup.model());
     const Projection projection = setup.sensor->projection();
     renderer->set_projection(projection, config.render.scale);
@@ -627,7 +636,9 @@ Tracker::Tracker(const Setup& setup, EngineConfig config, std::unique_ptr<Render
 Tracker::~Tracker() = default;
 
 Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::optional<double> stimulus) {
-  return impl_->process(frame, index, time_s, stimulus);
+  Estimate e = impl_->process(frame, index, time_s, stimulus);
+  e.hypothesis = impl_->frame.to_world(e.hypothesis);
+  return e;
 }
 
 void Tracker::reset() {
@@ -682,13 +693,16 @@ void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
   if (hypothesis.size() != impl_->config.space.dims()) {
     throw Error("set_estimate: expected " + std::to_string(impl_->config.space.dims()) + " parameters");
   }
-  impl_->last = hypothesis;
+  impl_->last = impl_->frame.from_world(hypothesis);
   impl_->forget_motion();
   impl_->started = true;
   impl_->lost = 0;
 }
 
-const std::optional<Eigen::VectorXd>& Tracker::last_estimate() const { return impl_->last; }
+std::optional<Eigen::VectorXd> Tracker::last_estimate() const {
+  if (!impl_->last) return std::nullopt;
+  return impl_->frame.to_world(*impl_->last);
+}
 const Observation& Tracker::last_observation() const { return impl_->observation; }
 
 CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
@@ -697,7 +711,7 @@ CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
     throw Error("tracker: score() got " + std::to_string(hypothesis.size()) + " parameters, the model has " +
                 std::to_string(impl_->config.space.dims()));
   }
-  return impl_->cost->evaluate_one(hypothesis);
+  return impl_->cost->evaluate_one(impl_->frame.from_world(hypothesis));
 }
 CostTerms Tracker::score_after(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& previous) {
   if (!impl_->started) throw Error("tracker: score_after() needs a processed frame");
@@ -711,14 +725,17 @@ CostTerms Tracker::score_after(const Eigen::VectorXd& hypothesis, const Eigen::V
   }
   auto& cost = *impl_->cost;
   const double allowance = cost.outside_allowance(), tolerance = cost.outside_tolerance();
-  impl_->set_allowance(impl_->whole_area(previous, impl_->renderer->render_mask(previous)));
+  const Eigen::VectorXd before = impl_->frame.from_world(previous);
+  impl_->set_allowance(impl_->whole_area(before, impl_->renderer->render_mask(before)));
   const CostTerms terms = score(hypothesis);
   cost.set_outside_allowance(allowance, tolerance);
   return terms;
 }
 
 double Tracker::temporal_term(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& prediction) const {
-  return temporal_distance(hypothesis, prediction, impl_->temporal_sigma(), impl_->wraps_rz());
+  const SensorFrame& f = impl_->frame;
+  return temporal_distance(f.from_world(hypothesis), f.from_world(prediction), impl_->temporal_sigma(),
+                           impl_->wraps_rz());
 }
 
 Renderer& Tracker::renderer() { return *impl_->renderer; }
@@ -732,7 +749,7 @@ const ParameterSpace& Tracker::space() const { return impl_->config.space; }
 namespace gtrack {
 
 cv::Mat Tracker::draw_overlay(const cv::Mat& frame, const Estimate& estimate) const {
-  return detail::draw_estimate(frame, *impl_->setup.sensor, impl_->setup.model(), impl_->setup.stimulus.get(),
+  return detail::draw_estimate(frame, *impl_->world_sensor, impl_->setup.model(), impl_->setup.stimulus.get(),
                                estimate);
 }
 
