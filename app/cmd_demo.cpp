@@ -105,6 +105,7 @@ GTRACK_COMMAND(
       d.add_options()("out,o", po::value<std::string>()->default_value("gtrack_demo"), "folder to write")(
           "frames,n", po::value<int>()->default_value(60), "frames to synthesise and track")(
           "seed,s", po::value<std::string>()->default_value("1"), "random seed of the sequence")(
-          "preset", po::value<std::string>()->default_value("microscope"), "synthetic setup");
+          "preset", po::value<std::string>()->default_value("microscope"),
+          ("synthetic setup, one of " + gtrack::synth_preset_names()).c_str());
     },
     run_demo)

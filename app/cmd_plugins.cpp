@@ -1,4 +1,5 @@
 // gtrack plugins: one line per plugin found (kind, name, version, file).
+#include <algorithm>
 #include <iostream>
 
 #include "command.hpp"
@@ -12,7 +13,9 @@ int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_o
     for (const auto& p : loader.search_paths()) std::cout << p.string() << "\n";
     return 0;
   }
-  const auto records = loader.discover();
+  auto records = loader.discover();
+  // Sensors, then grippers, then stimuli, each kind in the order found.
+  std::stable_sort(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.kind < b.kind; });
   if (records.empty()) {
     std::string where;
     for (const auto& p : loader.search_paths()) where += (where.empty() ? "" : ", ") + p.string();

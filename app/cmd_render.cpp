@@ -39,9 +39,9 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   so.plugin_paths = common.plugin_paths;
   so.with_stimulus = false;
   gtrack::Setup setup = gtrack::load_setup(vm["config"].as<std::string>(), so);
-  // The engine tables are not used here, but a config is checked whole, as
-  // `track` checks it: a typo found now is not a surprise later.
-  (void)gtrack::engine_config(setup);
+  // A config is checked whole, as `track` checks it: a typo found now is not
+  // a surprise later. Its [render] table gives the backend and its settings.
+  const gtrack::EngineConfig config = gtrack::engine_config(setup);
   gtrack::check_root_keys(setup);
   const std::string out = vm["out"].as<std::string>();
   check_writable(out, true);
@@ -52,8 +52,8 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
 
   const auto& model = setup.model();
   const Eigen::VectorXd h = gtrack::parse_parameter_vector(vm["params"].as<std::string>(), model.dims());
-  gtrack::RenderOptions ro;
-  ro.backend = vm["backend"].as<std::string>();
+  gtrack::RenderOptions ro = config.render;
+  gtrack::cli::backend_option(vm, ro.backend);
   ro.scale = vm["scale"].as<double>();
   if (!(ro.scale > 0 && ro.scale <= 1)) throw gtrack::cli::UsageError("--scale must be in (0, 1]");
   auto renderer = gtrack::make_renderer(ro);
@@ -94,7 +94,7 @@ GTRACK_COMMAND(
           "params,p", po::value<std::string>()->required(), "x,y,z,rx,ry,rz,q1,...,qF in mm and degrees")(
           "out,o", po::value<std::string>()->required(), "mask image to write (.png)")(
           "obj", po::value<std::string>(), "also write the posed mesh as Wavefront OBJ")(
-          "backend", po::value<std::string>()->default_value("cpu"), "auto, gl or cpu")(
+          "backend", po::value<std::string>(), "auto, gl or cpu (default: [render] backend)")(
           "scale", po::value<double>()->default_value(1.0), "render scale relative to the sensor image");
     },
     run_render)

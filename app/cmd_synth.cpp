@@ -1,5 +1,6 @@
 // gtrack synth: a synthetic sequence with ground truth (paper Section 5.1).
 #include <algorithm>
+#include <iomanip>
 #include <iostream>
 
 #include "command.hpp"
@@ -58,11 +59,11 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
   std::string unit;
   if (setup.stimulus) unit.append(" ").append(setup.stimulus->reading_unit());
-  std::cout << "synthetic sequence: " << s.frames << " frames (preset " << o.preset << ", seed " << o.seed << ") in "
+  std::cout << std::fixed << std::setprecision(1) << "synthetic sequence: " << s.frames << " frames (preset " << o.preset << ", seed " << o.seed << ") in "
             << s.seconds << " s -> " << out.string() << "\n"
             << "  occluded frames: " << s.occluded_frames << " (" << 100.0 * s.occluded_frames / s.frames
             << "%), mean " << 100 * s.mean_occlusion << "% of the shape, max " << 100 * s.max_occlusion << "%\n"
-            << "  partly out of view: " << s.partly_out_frames << ", out of view (<10% inside): "
+            << "  partly out of view (10-99% inside): " << s.partly_out_frames << ", out of view (<10% inside): "
             << s.out_of_view_frames << "\n"
             << "  stimulus: " << s.stimulus_min << " to " << s.stimulus_max << unit << " (the profile's range: "
             << s.stimulus_low << " to " << s.stimulus_high << unit << "), joints: " << s.joint_min_deg << " to "
@@ -89,7 +90,10 @@ GTRACK_COMMAND(
           "frames,n", po::value<int>()->default_value(300), "number of frames")(
           "seed,s", po::value<std::string>()->default_value("1"), "random seed: same seed, same sequence")(
           "preset", po::value<std::string>()->default_value("microscope"),
-          "setup: motion, look and noise (with --config: by default one of the look it segments, ultrasound for luminance)")(
+          ("setup: motion, look and noise; one of " + gtrack::synth_preset_names() +
+           ". With --config and no --preset: the preset whose config has the config's file name, else "
+           "microscope, or ultrasound for a config that segments grey levels")
+              .c_str())(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(
           "occlusion-scale", po::value<double>()->default_value(1.0),

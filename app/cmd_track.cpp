@@ -50,11 +50,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::Setup setup = gtrack::load_setup(vm["config"].as<std::string>(), so);
   gtrack::EngineConfig config = gtrack::engine_config(setup);
   gtrack::check_root_keys(setup);
-  if (vm.count("backend")) {
-    const std::string b = vm["backend"].as<std::string>();
-    if (b != "auto" && b != "gl" && b != "cpu") throw gtrack::cli::UsageError("--backend must be auto, gl or cpu");
-    config.render.backend = b;
-  }
+  gtrack::cli::backend_option(vm, config.render.backend);
 
   gtrack::TrackOptions opt;
   opt.input = vm["input"].as<std::string>();
@@ -165,7 +161,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
 }  // namespace
 
 GTRACK_COMMAND(
-    "track", "track a gripper in a video, an image folder or a live camera",
+    "track", "track a gripper in a video, an image folder, a TIFF stack or a live camera",
     [](po::options_description& d) {
       d.add_options()("config,c", po::value<std::string>()->required(), "TOML config naming sensor, gripper, stimulus")(
           "input,i", po::value<std::string>()->required(), "video file, folder of images, TIFF stack, or camera:N")(

@@ -112,6 +112,14 @@ inline void make_output_folder(const std::filesystem::path& dir, const std::stri
   }
 }
 
+// --backend, when given, in place of the config's [render] backend.
+inline void backend_option(const boost::program_options::variables_map& vm, std::string& backend) {
+  if (!vm.count("backend")) return;
+  const std::string b = vm["backend"].as<std::string>();
+  if (b != "auto" && b != "gl" && b != "cpu") throw UsageError("--backend must be auto, gl or cpu");
+  backend = b;
+}
+
 // --seed: a whole number from 0 to 2^64 - 1. Read as text, because the
 // option parser turns "-1" into 2^64 - 1 for an unsigned option.
 inline std::uint64_t seed_option(const boost::program_options::variables_map& vm) {

@@ -38,6 +38,10 @@ po::options_description common_options() {
   return d;
 }
 
+void print_version() {
+  std::cout << "gtrack " << GTRACK_VERSION_STRING << " (plugin ABI " << GTRACK_PLUGIN_ABI_VERSION << ")\n";
+}
+
 void print_usage(std::ostream& os) {
   os << "gtrack " << GTRACK_VERSION_STRING
      << " - model-based tracking of untethered micro-grippers\n\n"
@@ -91,7 +95,7 @@ int run(int argc, char** argv) {
   }
   const std::string first = argv[1];
   if (first == "--version") {
-    std::cout << "gtrack " << GTRACK_VERSION_STRING << " (plugin ABI " << GTRACK_PLUGIN_ABI_VERSION << ")\n";
+    print_version();
     return 0;
   }
   if (first == "--help" || first == "-h" || first == "help") {
@@ -125,8 +129,20 @@ int run(int argc, char** argv) {
       return 0;
     }
     if (vm.count("version")) {
-      std::cout << "gtrack " << GTRACK_VERSION_STRING << "\n";
+      print_version();
       return 0;
+    }
+    // Every required option missing, in the order --help lists them (the
+    // parser names only one).
+    std::string missing;
+    for (const auto& o : own.options()) {
+      if (o->semantic()->is_required() && !vm.count(o->long_name())) {
+        missing += (missing.empty() ? "--" : ", --") + o->long_name();
+      }
+    }
+    if (!missing.empty()) {
+      std::cerr << "gtrack: error: missing " << missing << " (see 'gtrack " << cmd->name << " --help')\n";
+      return 2;
     }
     po::notify(vm);
   } catch (const po::error& e) {

@@ -723,6 +723,11 @@ TEST(Cli, UsageErrors) {
   CliRun v = gtrack("--version");
   EXPECT_EQ(v.code, 0);
   EXPECT_NE(v.output.find("gtrack "), std::string::npos);
+  EXPECT_EQ(gtrack("track --version").output, v.output);
+  // Every required option missing is named, in the order --help lists them.
+  v = gtrack("eval");
+  EXPECT_EQ(v.code, 2);
+  EXPECT_NE(v.output.find("missing --truth, --estimates (see 'gtrack eval --help')"), std::string::npos) << v.output;
   // Numbers out of their range, NaN included, are refused before any work.
   const fs::path out = fs::temp_directory_path() / "gtrack_cli_test" / "usage";
   CliRun r = gtrack("synth --joint-noise nan --frames 2 --out " + out.string());

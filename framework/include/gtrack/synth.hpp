@@ -72,6 +72,8 @@ struct SynthPreset {
 };
 
 GTRACK_API const std::vector<SynthPreset>& synth_presets();
+// Their names, "microscope, ...", in the table's order.
+GTRACK_API std::string synth_preset_names();
 // Throws Error listing the presets when `name` is not one.
 GTRACK_API const SynthPreset& synth_preset(const std::string& name);
 
@@ -129,7 +131,7 @@ GTRACK_API cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int i
 struct SynthSummary {
   int frames = 0;
   int occluded_frames = 0;      // occluder covers more than 1% of the in-view shape
-  int partly_out_frames = 0;    // less than 99% in view
+  int partly_out_frames = 0;    // 10% to 99% in view (as gtrack eval counts them)
   int out_of_view_frames = 0;   // less than 10% in view
   double mean_occlusion = 0;    // over occluded frames
   double max_occlusion = 0;

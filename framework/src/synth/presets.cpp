@@ -80,9 +80,13 @@ const SynthPreset& synth_preset(const std::string& name) {
   const auto& all = synth_presets();
   auto it = std::find_if(all.begin(), all.end(), [&](const SynthPreset& p) { return p.name == name; });
   if (it != all.end()) return *it;
+  throw Error("unknown synthetic preset '" + name + "'; presets are: " + synth_preset_names());
+}
+
+std::string synth_preset_names() {
   std::string names;
-  for (const auto& p : all) names += (names.empty() ? "" : ", ") + p.name;
-  throw Error("unknown synthetic preset '" + name + "'; presets are: " + names);
+  for (const auto& p : synth_presets()) names += (names.empty() ? "" : ", ") + p.name;
+  return names;
 }
 
 }  // namespace gtrack

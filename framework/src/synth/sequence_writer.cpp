@@ -97,8 +97,11 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
         s.mean_occlusion += vis[i].occluded;
       }
       s.max_occlusion = std::max(s.max_occlusion, vis[i].occluded);
-      if (vis[i].in_view < 0.99) ++s.partly_out_frames;
-      if (vis[i].in_view < 0.10) ++s.out_of_view_frames;
+      if (vis[i].in_view < 0.10) {
+        ++s.out_of_view_frames;
+      } else if (vis[i].in_view < 0.99) {
+        ++s.partly_out_frames;
+      }
     }
     write_text_file(out / "ground_truth.csv", csv.str());
   }
