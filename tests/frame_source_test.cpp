@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <gtrack/frame_source.hpp>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -280,6 +282,71 @@ TEST(FrameSource, AGapInAFoldersNumberingIsWarnedAbout) {
   const fs::path whole = folder_of("whole", {"f0.png", "f1.png", "f2.png"});
   warned = logged([&] { gtrack::open_frame_source(whole.string(), {4, 4}, {}, 30); });
   EXPECT_EQ(warned, "");
+}
+
+// `in`, an AVI of OpenCV's MJPG writer, with frame `drop`'s chunk emptied
+// and the index rebuilt: a frame dropped as capture software records one.
+void drop_avi_frame(const fs::path& in, const fs::path& out, int drop) {
+  std::ifstream is(in, std::ios::binary);
+  const std::string d((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+  const auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, d.data() + at, 4);
+    return v;
+  };
+  const auto put = [](std::string& s, std::uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); };
+  const std::size_t movi = d.find("movi");
+  ASSERT_NE(movi, std::string::npos);
+  std::string body, index;
+  std::size_t i = movi + 4;
+  for (int k = 0; i + 8 <= d.size() && d.compare(i + 2, 2, "dc") == 0; ++k) {
+    const std::uint32_t n = u32(i + 4), kept = k == drop ? 0 : n;
+    index.append(d, i, 4);
+    put(index, 0x10);
+    put(index, static_cast<std::uint32_t>(4 + body.size()));
+    put(index, kept);
+    body.append(d, i, 4);
+    put(body, kept);
+    body.append(d, i + 8, kept + (kept & 1));
+    i += 8 + n + (n & 1);
+  }
+  std::string avi = d.substr(0, movi + 4) + body;
+  const auto list = static_cast<std::uint32_t>(4 + body.size());
+  std::memcpy(&avi[movi - 4], &list, 4);
+  avi += "idx1";
+  put(avi, static_cast<std::uint32_t>(index.size()));
+  avi += index;
+  const auto riff = static_cast<std::uint32_t>(avi.size() - 8);
+  std::memcpy(&avi[4], &riff, 4);
+  std::ofstream(out, std::ios::binary) << avi;
+}
+
+// A frame dropped from a recording is decoded as no frame at all: the
+// frames after it keep the source's numbers (and times), taken from their
+// time stamps, and the gap is warned about once.
+TEST(FrameSource, AFrameDroppedFromAVideoKeepsTheNumbersAfterIt) {
+  const fs::path dir = folder_of("dropped_video", {});
+  const fs::path whole = dir / "whole.avi", dropped = dir / "dropped.avi";
+  ASSERT_TRUE(write_video(whole, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 12)) << "no MJPG writer";
+  drop_avi_frame(whole, dropped, 5);
+  const std::vector<cv::Mat> reference = decoded_in_order(whole);
+  ASSERT_EQ(reference.size(), 12u);
+  for (const gtrack::FrameRange range : {gtrack::FrameRange{}, gtrack::FrameRange{2, -1, 2}}) {
+    std::vector<int> got;
+    const std::string warned = logged([&] {
+      auto src = gtrack::open_frame_source(dropped.string(), {128, 96}, range, 25);
+      while (auto f = src->next()) {
+        got.push_back(f->index);
+        EXPECT_DOUBLE_EQ(f->time_s, f->index / 25.0);
+        EXPECT_EQ(cv::norm(f->image, reference[static_cast<std::size_t>(f->index)], cv::NORM_INF), 0)
+            << "frame " << f->index;
+      }
+    });
+    EXPECT_EQ(got, range.every == 1 ? std::vector<int>({0, 1, 2, 3, 4, 6, 7, 8, 9, 10, 11})
+                                   : std::vector<int>({2, 4, 6, 8, 10}));
+    EXPECT_NE(warned.find("dropped.avi: frame 5 is missing (the time stamps go on at frame 6"), std::string::npos)
+        << warned;
+  }
 }
 
 // A 12-bit camera stores its values in the low bits of 16-bit files: at

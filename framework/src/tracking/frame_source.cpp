@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
@@ -132,14 +133,16 @@ class VideoSource final : public FrameSource {
       // The decoder's complaints are taken aside: said once, on one line,
       // when the video ends before its declared frames.
       detail::CapturedStderr decoder;
-      if (!filter_.wanted(index_)) {
-        if (!cap_.grab()) return end_of_stream(decoder.take());
+      if (!cap_.grab()) return end_of_stream(decoder.take());
+      follow_time_stamp();
+      if (filter_.done(index_)) return std::nullopt;
+      if (!filter_.wanted(index_)) {  // grabbed, never decoded into an image
         note(decoder.take());
         ++index_;
         continue;
       }
       cv::Mat img;
-      if (!cap_.read(img) || img.empty()) return end_of_stream(decoder.take());
+      if (!cap_.retrieve(img) || img.empty()) return end_of_stream(decoder.take());
       note(decoder.take());
       Frame f;
       f.index = index_++;
@@ -161,8 +164,37 @@ class VideoSource final : public FrameSource {
  private:
   void note(const std::string& said) {
     if (said.empty()) return;
-    logger().debug("{} frame {}: the decoder said: {}", name_, index_, said);
+    if (!warned_damage_ && !live_) {
+      logger().warn("{} frame {}: the decoder reported damage and the frame is tracked as decoded (the decoder "
+                    "said: {}); later such frames are logged at --log-level debug",
+                    name_, index_, said);
+      warned_damage_ = true;
+    } else {
+      logger().debug("{} frame {}: the decoder said: {}", name_, index_, said);
+    }
     if (last_said_.empty()) last_said_ = said;
+  }
+  // A frame missing from a recording (capture software writes a dropped
+  // frame as an empty chunk, which decoding skips) would shift the number
+  // of every frame after it. The frame just taken is numbered by its time
+  // stamp instead, counted from the first frame's, and the first gap is
+  // warned about. True when the number moved.
+  bool follow_time_stamp() {
+    if (live_ || !(fps_ > 0)) return false;
+    const double ms = cap_.get(cv::CAP_PROP_POS_MSEC);
+    if (!std::isfinite(ms) || ms < 0) return false;
+    const long long stamp = std::llround(ms * fps_ / 1000.0);
+    if (!stamp_base_) stamp_base_ = stamp - index_;
+    const long long source = stamp - *stamp_base_;
+    if (source <= index_ || source > std::numeric_limits<int>::max()) return false;
+    if (!warned_gap_) {
+      logger().warn("{}: frame {} is missing (the time stamps go on at frame {}, {:.1f} ms): frames are numbered "
+                    "by their time stamps, so that each keeps the source's number; later gaps are not warned about",
+                    name_, index_, source, ms);
+      warned_gap_ = true;
+    }
+    index_ = static_cast<int>(source);
+    return true;
   }
   std::optional<Frame> end_of_stream(const std::string& said) {
     // A video that opens but yields nothing is as unusable as one that does not open.
@@ -190,6 +222,8 @@ class VideoSource final : public FrameSource {
   int index_ = 0;
   int delivered_ = 0;
   bool seeked_ = false;
+  bool warned_damage_ = false, warned_gap_ = false;
+  std::optional<long long> stamp_base_;  // the first frame's time stamp in frames, less its number
   std::string last_said_;
   std::string ended_early_;
 };
