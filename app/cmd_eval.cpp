@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <string>
@@ -14,6 +15,7 @@
 #include "command.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
+#include "gtrack/frame_source.hpp"
 #include "gtrack/text_file.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
@@ -192,8 +194,21 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   if (!(opt.off_track_endpoint_um > 0 && std::isfinite(opt.off_track_endpoint_um))) {
     throw gtrack::cli::UsageError("--off-track-um must be a positive number");
   }
-  const auto truth = gtrack::read_truth_table(truth_file);
-  const auto estimates = gtrack::read_pose_table(estimates_file);
+  auto truth = gtrack::read_truth_table(truth_file);
+  auto estimates = gtrack::read_pose_table(estimates_file);
+  // --frames and --every as the run had them: only the frames it tracked are judged.
+  gtrack::FrameRange range;
+  if (vm.count("frames")) range = gtrack::parse_frame_range(vm["frames"].as<std::string>());
+  range.every = vm["every"].as<int>();
+  if (range.every < 1) throw gtrack::cli::UsageError("--every must be at least 1");
+  const auto selected = [&](int f) {
+    return f >= range.first && (range.last < 0 || f < range.last) && (f - range.first) % range.every == 0;
+  };
+  const bool had_rows = !truth.rows.empty();
+  for (auto* t : {&truth, &estimates}) std::erase_if(t->rows, [&](const auto& r) { return !selected(r.frame); });
+  if (had_rows && truth.rows.empty()) {
+    throw gtrack::cli::UsageError("--frames/--every select none of the frames of " + truth_file.string());
+  }
   for (const auto* t : {&truth, &estimates}) {
     if (t->rows.empty()) {
       throw gtrack::InputError((t == &truth ? truth_file : estimates_file).string() +
@@ -234,6 +249,23 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
                           estimates_file.string(), unmatched.size(), truth_file.string(), unmatched.front());
   }
   const auto ev = gtrack::evaluate(setup.model(), truth, estimates, opt, setup.sensor.get());
+  // A run with --frames or --every leaves the frames it did not take
+  // without a row: they count as lost, which is said with the remedy.
+  if (ev.missing_frames > 0 && !estimates.rows.empty()) {
+    int stride = 0;
+    for (std::size_t i = 1; i < estimates.rows.size(); ++i) {
+      stride = std::gcd(stride, std::abs(estimates.rows[i].frame - estimates.rows[i - 1].frame));
+    }
+    const int first = estimates.rows.front().frame;
+    if (stride > 1 || first > truth.rows.front().frame) {
+      std::string options = "--frames " + std::to_string(first) + ":";
+      if (stride > 1) options += " --every " + std::to_string(stride);
+      gtrack::logger().warn("{} frames of {} have no estimate and count as lost; the estimates start at frame {}{}: "
+                            "for a run that tracked only those ({}), evaluate with the same options",
+                            ev.missing_frames, truth_file.string(), first,
+                            stride > 1 ? " and hold one frame in " + std::to_string(stride) : std::string(), options);
+    }
+  }
 
   std::cout << "frames " << ev.frames << ": " << ev.in_view_frames << " in view (" << ev.evaluated_frames
             << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames
@@ -297,6 +329,9 @@ GTRACK_COMMAND(
                        "whether the truth scored lower than the estimate")(
           "out-of-view-below", po::value<double>()->default_value(0.1, "0.1"),
           "share of the gripper inside the image under which a frame counts as out of view")(
+          "frames", po::value<std::string>(),
+          "judge only frames A:B (A inclusive, B exclusive), as the run's --frames")(
+          "every", po::value<int>()->default_value(1), "judge only every K-th frame of them, as the run's --every")(
           "off-track-um", po::value<double>()->default_value(400.0, "400"),
           "mean endpoint error above which an estimate is off the gripper (recovery)");
     },

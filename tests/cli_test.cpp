@@ -486,6 +486,38 @@ TEST(Cli, AnEndlessConfigOrTableIsStopped) {
   EXPECT_NE(r.output.find("/dev/zero:1: a line of more than 65536 characters"), std::string::npos) << r.output;
 }
 
+// A run with --frames and --every has no row for the frames it skipped:
+// eval counts them as lost and says which options judge only the others;
+// with them, only those frames are judged.
+TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_every";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 7 --seed 6 --out " + dir.string()).code, 0);
+  std::ifstream in(dir / "ground_truth.csv");
+  std::string text;
+  int line = 0;
+  for (std::string l; std::getline(in, l); ++line) {
+    // The truth's pose columns without visible, in_view, occluded: frames 1, 3, 5.
+    for (int k = 0; k < 3; ++k) l = l.substr(0, l.rfind(','));
+    if (line == 0 || line % 2 == 0) text += l + "\n";
+  }
+  const fs::path estimates = write("every_other.csv", text);
+  const std::string eval = "eval -t " + (dir / "ground_truth.csv").string() + " -e " + estimates.string();
+  CliRun r = gtrack(eval);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("4 frames of"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(--frames 1: --every 2), evaluate with the same options"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("lost in all 4 (missing 4)"), std::string::npos) << r.output;
+  r = gtrack(eval + " --frames 1: --every 2");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("frames 3: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("lost in all 0 (missing 0)"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("have no estimate"), std::string::npos) << r.output;
+  r = gtrack(eval + " --frames 7:");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--frames/--every select none of the frames of"), std::string::npos) << r.output;
+}
+
 TEST(Cli, EvalRefusesMalformedTables) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_strict";
   fs::remove_all(dir);
