@@ -233,6 +233,20 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
   const std::string said = "decoding stopped at frame " + std::to_string(s.frames) + " of the 20 the video declares";
   EXPECT_EQ(s.input_ended_early.rfind(said, 0), 0u) << s.input_ended_early;
   EXPECT_NE(read_text(o.out_dir / "summary.json").find("\"input_ended_early\": \"" + said), std::string::npos);
+  // A range that starts past where decoding stops gives nothing: an error
+  // that says so, not a run of no frames.
+  gtrack::TrackOptions late = o;
+  late.out_dir = dir / "late";
+  late.range.first = 15;
+  try {
+    gtrack::track_sequence(r.setup, r.config, late);
+    ADD_FAILURE() << "a range past the damage was tracked";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(said), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("before the first frame of --frames 15:; nothing was tracked"),
+              std::string::npos)
+        << e.what();
+  }
   // A whole video ends where it says.
   fs::remove(avi);
   {

@@ -137,13 +137,13 @@ class VideoSource final : public FrameSource {
       follow_time_stamp();
       if (filter_.done(index_)) return std::nullopt;
       if (!filter_.wanted(index_)) {  // grabbed, never decoded into an image
-        note(decoder.take());
+        note(decoder.take(), false);
         ++index_;
         continue;
       }
       cv::Mat img;
       if (!cap_.retrieve(img) || img.empty()) return end_of_stream(decoder.take());
-      note(decoder.take());
+      note(decoder.take(), true);
       Frame f;
       f.index = index_++;
       f.time_s = fps_ > 0 ? f.index / fps_ : 0.0;
@@ -162,9 +162,11 @@ class VideoSource final : public FrameSource {
   bool seeked() const { return seeked_; }
 
  private:
-  void note(const std::string& said) {
+  // What the decoder said while taking frame index_ (`taken`: into an
+  // image to track, not only skipped over).
+  void note(const std::string& said, bool taken) {
     if (said.empty()) return;
-    if (!warned_damage_ && !live_) {
+    if (taken && !warned_damage_ && !live_) {
       logger().warn("{} frame {}: the decoder reported damage and the frame is tracked as decoded (the decoder "
                     "said: {}); later such frames are logged at --log-level debug",
                     name_, index_, said);
@@ -208,7 +210,8 @@ class VideoSource final : public FrameSource {
     if (!live_ && count_ > 0 && index_ < count_ - (why.empty() ? 1 : 0) && ended_early_.empty()) {
       ended_early_ = "decoding stopped at frame " + std::to_string(index_) + " of the " + std::to_string(count_) +
                      " the video declares" + (why.empty() ? std::string() : " (the decoder said: " + why + ")");
-      logger().warn("{}: {}; the frames before it are tracked", name_, ended_early_);
+      logger().warn("{}: {}; {}", name_, ended_early_,
+                    delivered_ > 0 ? "the frames before it are tracked" : "no frame asked for comes before it");
     }
     return std::nullopt;
   }

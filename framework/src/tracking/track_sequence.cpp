@@ -425,6 +425,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   warn_unused(options.score_truth, reference_rows, references_used, "--score-truth", "a tracked frame");
   // Resuming a finished run tracks nothing: its summary stays as it was.
   if (!(resumed && summary.frames == 0)) write_summary(options.out_dir / "summary.json", summary);
+  // A damaged video that stops before the range's first frame gives nothing.
+  if (!resumed && summary.frames == 0 && !summary.cancelled && !summary.input_ended_early.empty()) {
+    throw InputError(options.input + ": " + summary.input_ended_early + ", before the first frame of --frames " +
+                     std::to_string(range.first) + ":" + (range.last >= 0 ? std::to_string(range.last) : "") +
+                     "; nothing was tracked");
+  }
   return summary;
 }
 
