@@ -127,10 +127,12 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
                      : opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
                                            : " (the same command with --resume continues)";
   if (s.cancelled && g_reader_gone) {
-    std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames << " frames, kept in "
+    std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames
+              << (s.frames == 1 ? " frame" : " frames") << ", kept in "
               << opt.out_dir.string() << next << "\n";
   } else if (s.cancelled) {
-    std::cerr << "gtrack track: interrupted; " << s.frames << " finished frames kept in " << opt.out_dir.string()
+    std::cerr << "gtrack track: interrupted; " << s.frames << (s.frames == 1 ? " finished frame" : " finished frames")
+              << " kept in " << opt.out_dir.string()
               << next << "\n";
   }
   std::FILE* report = stream ? stderr : stdout;
@@ -146,6 +148,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (two_pass) {
     const gtrack::TwoPassSummary t = gtrack::two_pass(setup, config, opt, forward);
     if (t.cancelled) {
+      // The summary says the run was interrupted, as the exit status does.
+      gtrack::TrackSummary interrupted = s;
+      interrupted.cancelled = true;
+      gtrack::write_summary(opt.out_dir / "summary.json", interrupted);
       std::cerr << "gtrack track: interrupted after the forward run (kept in " << opt.out_dir.string()
                 << "); the backward track's finished frames are in " << (opt.out_dir / "backward").string()
                 << ", no two-pass table was written\n";
