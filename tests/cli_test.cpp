@@ -347,6 +347,11 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   const fs::path key = write("fxx.toml", replaced(base, "\nfx = ", "\nfxx = "));
   CliRun r = gtrack("render -c " + key.string() + kParams);
   expect_refusal(r, "key 'sensor.fx': missing; expected a number in (0, 1e+08] (is 'fxx' on line ");
+  // Not fy, its sibling, which is read after it.
+  const fs::path sibling = write("focal.toml", replaced(base, "\nfx = ", "\nfocal_length = "));
+  r = gtrack("render -c " + sibling.string() + kParams);
+  EXPECT_NE(r.output.find("key 'sensor.fx': missing"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("is 'fy'"), std::string::npos) << r.output;
   const fs::path plugin =
       write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
   r = gtrack("render -c " + plugin.string() + kParams);

@@ -500,9 +500,13 @@ std::vector<std::string> ConfigTable::strings_or(std::string_view key, std::vect
 
 std::string ConfigTable::misspelling_hint(std::string_view key) const {
   if (!impl_->table) return {};
+  // Two-letter keys come in families one letter apart (fx, fy; cx, cy): an
+  // unread one of the same length is more likely a key still to be read
+  // than a typo.
   std::vector<std::string> unread;
   for (auto&& [k, v] : *impl_->table) {
-    if (!impl_->used->count(std::string(k.str())) && k.str() != key) unread.emplace_back(k.str());
+    const bool sibling = key.size() <= 2 && k.str().size() == key.size();
+    if (!impl_->used->count(std::string(k.str())) && k.str() != key && !sibling) unread.emplace_back(k.str());
   }
   const auto m = closest_match(key, unread);
   if (!m) return {};
