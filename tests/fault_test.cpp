@@ -693,6 +693,18 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
   r = load();
   EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, second).frames, 0);
   EXPECT_EQ(rows_without_time(dir / "out" / "estimates.csv"), reference);
+
+  // An overlay the killed run never closed (an mp4 with no index) is said
+  // to be unreadable when the run is resumed.
+  std::ofstream(dir / "out" / "overlay.mp4") << std::string(48, '\0');
+  second.overlay = true;
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  r = load();
+  gtrack::track_sequence(r.setup, r.config, second);
+  gtrack::logger().sinks().pop_back();
+  EXPECT_NE(log.str().find("overlay.mp4: cannot be read (a video is whole only once it is closed"), std::string::npos)
+      << log.str();
 }
 
 // Killed while writing (power cut, kill -9): a row cut short, or written

@@ -18,6 +18,7 @@
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
+#include "captured_stderr.hpp"
 #include "nearest_equivalent.hpp"
 #include "replace_file.hpp"
 #include "run_config.hpp"
@@ -70,6 +71,28 @@ class OverlayWriter {
   fs::path file_;
   bool failed_ = false;
 };
+
+// The overlays of the runs before a resumed one: a video killed before it
+// was closed (kill -9, a crash, a power loss) may not open at all (an mp4
+// has no index until it is closed), which is said once per file.
+void check_earlier_overlays(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("overlay", 0) != 0 || !entry.is_regular_file(ec)) continue;
+    cv::VideoCapture video;
+    {
+      detail::CapturedStderr decoder;  // "moov atom not found"
+      video.open(entry.path().string());
+    }
+    cv::Mat first;
+    if (video.isOpened() && video.read(first) && !first.empty()) continue;
+    logger().warn("{}: cannot be read (a video is whole only once it is closed, and the run that wrote it was "
+                  "stopped without closing it); the frames it held have no overlay (a run without --resume draws "
+                  "them all again)",
+                  entry.path().string());
+  }
+}
 
 class Progress {
  public:
@@ -313,6 +336,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                   options.out_dir.string());
   }
   const bool want_overlay = options.overlay.value_or(config.tracker.overlay);
+  if (resumed && want_overlay) check_earlier_overlays(options.out_dir);
   char overlay_stem[48] = "overlay";
   if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", range.first);
   OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem);
