@@ -177,7 +177,7 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
              "2>" + err.string() + " | head -n 1");
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
   EXPECT_EQ(lines(waiting.output), 1) << waiting.output;
-  EXPECT_NE(read_file(err).find("stdout was closed by its reader; stopped after 1 frames"), std::string::npos)
+  EXPECT_NE(read_file(err).find("stdout was closed by its reader; stopped after 1 frame,"), std::string::npos)
       << read_file(err);
 
   // stdout closed before the run (`>&-`): the lines go nowhere, not into the

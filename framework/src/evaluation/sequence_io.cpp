@@ -113,8 +113,9 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
     row.h.resize(kPoseDims + table.fingers);
     for (int d = 0; d < row.h.size(); ++d) {
       if (!parse_number(cells[idx[d + 1]], row.h[d])) {
-        throw InputError(where + "expected a number for '" + names[d + 1] + "', got '" +
-                         shown(cells[idx[d + 1]], 60) + "'");
+        throw InputError(where + "expected a number for '" + names[d + 1] + "', got " +
+                         (cells[idx[d + 1]].empty() ? std::string("an empty cell (a lost frame's cells hold nan)")
+                                                    : "'" + shown(cells[idx[d + 1]], 60) + "'"));
       }
       if (finite && !std::isfinite(row.h[d])) {
         throw InputError(where + "expected a finite number for '" + names[d + 1] + "' in a ground truth (frame " +
@@ -138,7 +139,7 @@ static PoseTable read_table(const std::filesystem::path& file, bool finite) {
         int d = 0;
         while (std::isfinite(row.h[d])) ++d;
         throw InputError(where + "expected a finite number for '" + names[d + 1] + "' in a row whose status is " +
-                         row.status + " (only a lost frame may have none)");
+                         row.status + " (only a lost frame may hold nan)");
       }
     }
     for (size_t e = 0; e < extra_idx.size(); ++e) {
