@@ -181,13 +181,30 @@ class VideoSource final : public FrameSource {
   // of every frame after it. The frame just taken is numbered by its time
   // stamp instead, counted from the first frame's, and the first gap is
   // warned about. True when the number moved.
+  //
+  // Only while the stamps agree with the declared rate: the first two
+  // frames must be one frame apart. A video whose stamps run at another
+  // rate than it declares (a variable-rate recording whose declared rate is
+  // the time base's) is numbered by order, as before.
   bool follow_time_stamp() {
-    if (live_ || !(fps_ > 0)) return false;
+    if (live_ || !(fps_ > 0) || stamps_disagree_) return false;
     const double ms = cap_.get(cv::CAP_PROP_POS_MSEC);
     if (!std::isfinite(ms) || ms < 0) return false;
     const long long stamp = std::llround(ms * fps_ / 1000.0);
-    if (!stamp_base_) stamp_base_ = stamp - index_;
+    if (!stamp_base_) {
+      stamp_base_ = stamp - index_;
+      return false;
+    }
     const long long source = stamp - *stamp_base_;
+    if (!stamps_checked_) {
+      stamps_checked_ = true;
+      if (source != index_) {
+        stamps_disagree_ = true;
+        logger().debug("{}: time stamps not one frame apart at {} frames/s; frames numbered by their order", name_,
+                       fps_);
+        return false;
+      }
+    }
     if (source <= index_ || source > std::numeric_limits<int>::max()) return false;
     if (!warned_gap_) {
       logger().warn("{}: frame {} is missing (the time stamps go on at frame {}, {:.1f} ms): frames are numbered "
@@ -226,6 +243,7 @@ class VideoSource final : public FrameSource {
   int delivered_ = 0;
   bool seeked_ = false;
   bool warned_damage_ = false, warned_gap_ = false;
+  bool stamps_checked_ = false, stamps_disagree_ = false;
   std::optional<long long> stamp_base_;  // the first frame's time stamp in frames, less its number
   std::string last_said_;
   std::string ended_early_;
