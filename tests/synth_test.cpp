@@ -16,6 +16,7 @@
 #include "gtrack/renderer.hpp"
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/synth.hpp"
+#include "support/plugins.hpp"
 
 namespace fs = std::filesystem;
 
@@ -59,13 +60,8 @@ TEST(Synth, SegmentedFrameMatchesTheRenderedTruth) {
 // centre in its slab and its palm facing along the slice's normal as much
 // as the upright probe's do.
 TEST(Synth, ATurnedProbeSeesTheSequenceAnUprightOneSees) {
-  const std::string upright_text =
-      "[sensor]\nplugin = \"ultrasound_slice\"\n[gripper]\nplugin = \"hydrogel_six_finger\"\n"
-      "[stimulus]\nplugin = \"temperature_hysteresis\"\n";
-  std::string turned_text = upright_text;
-  turned_text.insert(turned_text.find("[gripper]"), "probe_rotation_deg = [90, 0, 0]\n");
-  const gtrack::Setup upright = gtrack::load_setup(gtrack::ConfigTable::parse(upright_text, "u.toml"), {});
-  const gtrack::Setup turned = gtrack::load_setup(gtrack::ConfigTable::parse(turned_text, "t.toml"), {});
+  const gtrack::Setup upright = gtrack::testing::probe_setup();
+  const gtrack::Setup turned = gtrack::testing::probe_setup("[90, 0, 0]");
   gtrack::SynthOptions o;
   o.frames = 30;
   o.preset = "ultrasound";

@@ -23,6 +23,7 @@
 #include "gtrack/synth.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/tracker_state.hpp"
+#include "support/plugins.hpp"
 
 namespace fs = std::filesystem;
 
@@ -322,22 +323,15 @@ TEST(Tracker, NothingDetectedIsLostNotAnError) {
   EXPECT_EQ(e.hypothesis, pose(0.3, -0.2, 20, 5));  // held
 }
 
-// `initial_pose` starts the first frame that shows the gripper, also when
-// frames before it showed nothing: the track starts there (status tracked),
-// not from a coarse search.
 // The tracker searches in the sensor's own frame: a probe turned in the
 // world (looking down world -z, its slice the world's x-z plane) that sees
 // the images an upright probe sees gives the upright probe's estimates,
 // turned with it, and scores them as it does. Searched in the world's
 // frame, its tilts were taken about the wrong axes (60 deg off on average).
 TEST(Tracker, ATurnedProbeIsTrackedAsTheUprightOne) {
-  const std::string upright_text =
-      "[sensor]\nplugin = \"ultrasound_slice\"\n[gripper]\nplugin = \"hydrogel_six_finger\"\n"
-      "[stimulus]\nplugin = \"temperature_hysteresis\"\n[render]\nbackend = \"cpu\"\nthreads = 2\n";
-  std::string turned_text = upright_text;
-  turned_text.insert(turned_text.find("[gripper]"), "probe_rotation_deg = [-90, 0, 0]\n");
-  const auto upright = gtrack::load_setup(gtrack::ConfigTable::parse(upright_text, "u.toml"), {});
-  const auto turned = gtrack::load_setup(gtrack::ConfigTable::parse(turned_text, "t.toml"), {});
+  const std::string engine = "[render]\nbackend = \"cpu\"\nthreads = 2\n";
+  const auto upright = gtrack::testing::probe_setup("", engine);
+  const auto turned = gtrack::testing::probe_setup("[-90, 0, 0]", engine);
   const gtrack::SensorFrame frame = gtrack::sensor_frame(*turned.sensor);
   ASSERT_TRUE(gtrack::sensor_frame(*upright.sensor).is_world());
   ASSERT_LT((frame.axes * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitY()).norm(), 1e-12);
@@ -373,6 +367,9 @@ TEST(Tracker, ATurnedProbeIsTrackedAsTheUprightOne) {
   }
 }
 
+// `initial_pose` starts the first frame that shows the gripper, also when
+// frames before it showed nothing: the track starts there (status tracked),
+// not from a coarse search.
 TEST(Tracker, InitialPoseOutlastsEmptyFirstFrames) {
   auto setup = make_setup("[tracker]\ninitial_pose = [0.1, 0.1, 100.0, 8, -6, 10, 10, 10, 10, 10, 10, 10]\n");
   gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
@@ -1043,12 +1040,10 @@ TEST(EngineConfig, InitialPoseMustHaveEveryParameter) {
 // read in the world and taken into the sensor's frame, where the tracker
 // searches: the box becomes the box about its corners there.
 TEST(EngineConfig, ATurnedSensorsBoxAndInitialPoseAreTakenIntoItsFrame) {
-  const std::string text =
-      "[sensor]\nplugin = \"ultrasound_slice\"\nprobe_rotation_deg = [-90, 0, 0]\n[gripper]\nplugin = "
-      "\"hydrogel_six_finger\"\n[stimulus]\nplugin = \"temperature_hysteresis\"\n[search]\n"
-      "position_min_mm = [-1.0, -2.0, -30.0]\nposition_max_mm = [1.0, 2.0, -20.0]\n[tracker]\n"
-      "initial_pose = [0.5, 1.0, -25.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n";
-  const auto setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "t.toml"), {});
+  const auto setup = gtrack::testing::probe_setup(
+      "[-90, 0, 0]",
+      "[search]\nposition_min_mm = [-1.0, -2.0, -30.0]\nposition_max_mm = [1.0, 2.0, -20.0]\n[tracker]\n"
+      "initial_pose = [0.5, 1.0, -25.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n");
   const auto config = gtrack::engine_config(setup);
   const gtrack::SensorFrame frame = gtrack::sensor_frame(*setup.sensor);
   ASSERT_FALSE(frame.is_world());
