@@ -414,6 +414,15 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   EXPECT_NE(jsonl[4].find("\"stimulus\":30.0000"), std::string::npos) << jsonl[4];
   EXPECT_NE(jsonl[0].find("\"D\":"), std::string::npos);
   EXPECT_NE(jsonl[0].find("\"unseen_fingers\":["), std::string::npos) << jsonl[0];
+  // Each row names its image and when it was written.
+  EXPECT_NE(jsonl[4].find("\"image\":\"" + (seq / "frames" / "000004.png").string() + "\""), std::string::npos)
+      << jsonl[4];
+  const auto stamp = jsonl[4].find("\"unix_time_s\":");
+  ASSERT_NE(stamp, std::string::npos) << jsonl[4];
+  const double written = std::stod(jsonl[4].substr(stamp + 14));
+  const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  EXPECT_GT(written, now - 600);
+  EXPECT_LE(written, now);
   EXPECT_TRUE(fs::exists(opt.out_dir / "summary.json"));
   EXPECT_TRUE(fs::exists(opt.out_dir / "masks" / "000004.png"));
   EXPECT_FALSE(s.overlay_file.empty());

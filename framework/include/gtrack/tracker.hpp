@@ -88,6 +88,12 @@ struct Estimate {
   std::string two_pass_source;
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
+  // Set by track_sequence(): the image the frame came from (an image's
+  // path, "<video> frame N") and when its estimate was written (seconds
+  // since the Unix epoch, this machine's clock), for matching a streamed
+  // estimate with its image and measuring the delay; "" and 0 otherwise.
+  std::string image;
+  double unix_time_s = 0;
 };
 
 // One Tracker follows one sequence. It keeps the Setup's plugin instances

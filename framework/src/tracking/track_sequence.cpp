@@ -408,6 +408,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (want_overlay) overlay.write(tracker.draw_overlay(frame->image, e));
     io_ms += seconds_since(t_write) * 1e3;
     e.times.io_ms = io_ms;
+    e.image = frame->name;
+    e.unix_time_s =
+        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
     results.write(e);
     if (options.durable) results.sync();  // the rows before the state that says they are done
     TrackerState state = tracker.state();
