@@ -15,7 +15,6 @@
 #include "command.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
-#include "gtrack/frame_source.hpp"
 #include "gtrack/text_file.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
@@ -197,15 +196,9 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   auto truth = gtrack::read_truth_table(truth_file);
   auto estimates = gtrack::read_pose_table(estimates_file);
   // --frames and --every as the run had them: only the frames it tracked are judged.
-  gtrack::FrameRange range;
-  if (vm.count("frames")) range = gtrack::parse_frame_range(vm["frames"].as<std::string>());
-  range.every = vm["every"].as<int>();
-  if (range.every < 1) throw gtrack::cli::UsageError("--every must be at least 1");
-  const auto selected = [&](int f) {
-    return f >= range.first && (range.last < 0 || f < range.last) && (f - range.first) % range.every == 0;
-  };
+  const gtrack::FrameRange range = gtrack::cli::frame_range_option(vm);
   const bool had_rows = !truth.rows.empty();
-  for (auto* t : {&truth, &estimates}) std::erase_if(t->rows, [&](const auto& r) { return !selected(r.frame); });
+  for (auto* t : {&truth, &estimates}) std::erase_if(t->rows, [&](const auto& r) { return !range.contains(r.frame); });
   if (had_rows && truth.rows.empty()) {
     throw gtrack::cli::UsageError("--frames/--every select none of the frames of " + truth_file.string());
   }

@@ -56,10 +56,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.input = vm["input"].as<std::string>();
   if (vm.count("stimulus")) opt.stimulus_csv = vm["stimulus"].as<std::string>();
   opt.out_dir = vm["out"].as<std::string>();
-  if (vm.count("frames")) opt.range = gtrack::parse_frame_range(vm["frames"].as<std::string>());
-  const int every = vm["every"].as<int>();
-  if (every < 1) throw gtrack::cli::UsageError("--every must be at least 1");
-  opt.range.every = every;
+  opt.range = gtrack::cli::frame_range_option(vm);
   opt.save_masks = vm.count("save-masks") > 0;
   if (vm.count("no-overlay")) opt.overlay = false;
   opt.resume = vm.count("resume") > 0;

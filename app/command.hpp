@@ -7,6 +7,7 @@
 #pragma once
 
 #include <boost/program_options.hpp>
+#include <gtrack/frame_source.hpp>
 #include <charconv>
 #include <cstdint>
 #include <filesystem>
@@ -118,6 +119,15 @@ inline void backend_option(const boost::program_options::variables_map& vm, std:
   const std::string b = vm["backend"].as<std::string>();
   if (b != "auto" && b != "gl" && b != "cpu") throw UsageError("--backend must be auto, gl or cpu");
   backend = b;
+}
+
+// --frames and --every (a command that declares both).
+inline FrameRange frame_range_option(const boost::program_options::variables_map& vm) {
+  FrameRange range;
+  if (vm.count("frames")) range = parse_frame_range(vm["frames"].as<std::string>());
+  range.every = vm["every"].as<int>();
+  if (range.every < 1) throw UsageError("--every must be at least 1");
+  return range;
 }
 
 // --seed: a whole number from 0 to 2^64 - 1. Read as text, because the

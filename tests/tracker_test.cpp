@@ -1072,6 +1072,54 @@ TEST(EngineConfig, ATurnedSensorsBoxAndInitialPoseAreTakenIntoItsFrame) {
   EXPECT_LT((frame.to_world(*config.tracker.initial_pose) - pose).norm(), 1e-9);
 }
 
+// An oblique probe: the box about the world box's corners in the probe's
+// frame is larger than the world box, and the search is kept within the
+// world box itself; an initial pose outside it, or tilted past the bounds
+// in the probe's frame, is refused naming why.
+TEST(EngineConfig, ATurnedSensorsSearchStaysInTheWorldBox) {
+  const std::string box = "[search]\nposition_min_mm = [11.0, 16.0, -3.0]\nposition_max_mm = [14.0, 22.0, 10.0]\n";
+  const auto setup = gtrack::testing::probe_setup("[30, 45, 10]", box);
+  const auto config = gtrack::engine_config(setup);
+  const gtrack::SensorFrame frame = gtrack::sensor_frame(*setup.sensor);
+  ASSERT_TRUE(config.space.position_box);
+  std::mt19937_64 rng(5);
+  int moved = 0;
+  for (int i = 0; i < 200; ++i) {
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(12);
+    for (int d = 0; d < 3; ++d) {
+      h[d] = std::uniform_real_distribution<double>(config.space.lower[d], config.space.upper[d])(rng);
+    }
+    const Eigen::Vector3d before = frame.point_to_world(h.head<3>());
+    config.space.clamp(h);
+    const Eigen::Vector3d world = frame.point_to_world(h.head<3>());
+    EXPECT_TRUE((world.array() >= Eigen::Array3d(11, 16, -3) - 1e-9).all() &&
+                (world.array() <= Eigen::Array3d(14, 22, 10) + 1e-9).all())
+        << world.transpose();
+    EXPECT_TRUE(config.space.contains(h));
+    moved += (world - before).norm() > 1e-9;
+  }
+  EXPECT_GT(moved, 50);  // the box about the corners holds much outside the world box
+  const std::string pose = "[tracker]\ninitial_pose = [16.0, 19.0, 3.0, 0.0, 0.0, 0.0, 0, 0, 0, 0, 0, 0]\n";
+  try {
+    gtrack::engine_config(gtrack::testing::probe_setup("[30, 45, 10]", box + pose));
+    ADD_FAILURE() << "an initial pose outside the world box was taken";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("its position lies outside the [search] position box"), std::string::npos)
+        << e.what();
+  }
+  // A probe looking down world -z sees a gripper lying flat edge-on (rx =
+  // 90 deg in its frame); tilted 10 deg more, it is past the default bounds.
+  try {
+    gtrack::engine_config(gtrack::testing::probe_setup(
+        "[-90, 0, 0]", "[tracker]\ninitial_pose = [0.0, 0.0, -20.0, 10.0, 0.0, 0.0, 0, 0, 0, 0, 0, 0]\n"));
+    ADD_FAILURE() << "a pose tilted past the bounds was taken";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("rx_deg is 100, outside [-90, 90] (the angles taken in the sensor's frame"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 
 namespace {

@@ -8,10 +8,11 @@ namespace gtrack {
 
 namespace {
 
-// `h` with its position and orientation turned by `axes` about `origin`.
-Eigen::VectorXd turned(const Eigen::VectorXd& h, const Eigen::Matrix3d& axes, const Eigen::Vector3d& origin) {
+// `h` with its position moved by `point` and its orientation turned by `axes`.
+template <class Point>
+Eigen::VectorXd turned(const Eigen::VectorXd& h, const Eigen::Matrix3d& axes, Point point) {
   Eigen::VectorXd out = h;
-  out.head<3>() = origin + axes * (h.head<3>() - origin);
+  out.head<3>() = point(Eigen::Vector3d(h.head<3>()));
   out.segment<3>(3) = euler_deg_from_rotation(axes * rotation_from_euler_deg(h[3], h[4], h[5]));
   return out;
 }
@@ -35,7 +36,7 @@ class SensorInFrame final : public Sensor {
   }
 
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& p) const override {
-    return sensor_->project(frame_.origin + frame_.axes * (p - frame_.origin));
+    return sensor_->project(frame_.point_to_world(p));
   }
 
   cv::Mat rectify(const cv::Mat& frame) const override { return sensor_->rectify(frame); }
@@ -63,11 +64,11 @@ Eigen::Vector3d viewing_axis(const Projection& projection) {
 bool SensorFrame::is_world() const { return (axes - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12; }
 
 Eigen::VectorXd SensorFrame::to_world(const Eigen::VectorXd& h) const {
-  return is_world() ? h : turned(h, axes, origin);
+  return is_world() ? h : turned(h, axes, [this](const Eigen::Vector3d& p) { return point_to_world(p); });
 }
 
 Eigen::VectorXd SensorFrame::from_world(const Eigen::VectorXd& h) const {
-  return is_world() ? h : turned(h, axes.transpose(), origin);
+  return is_world() ? h : turned(h, axes.transpose(), [this](const Eigen::Vector3d& p) { return point_from_world(p); });
 }
 
 SensorFrame sensor_frame(const Sensor& sensor) {

@@ -119,10 +119,14 @@ struct CostWeights {
 // TrackerConfig::initial_pose, are in the sensor's own frame (SensorFrame in
 // sensor.hpp: rx, ry tilt away from face-on, rz turns about the line of
 // sight), which for a sensor looking down world z is the world's. The config
-// gives positions in the world, angles in the sensor's frame.
+// gives positions in the world, angles in the sensor's frame. For a turned
+// sensor given a position box, the bounds below are the box about its
+// corners in the sensor's frame, and `world_box` (ParameterSpace's
+// position_box) keeps the positions searched within the world's box.
 struct SearchConfig {
   Eigen::Vector3d position_min_mm{0, 0, 0}, position_max_mm{0, 0, 0};
   Eigen::Vector3d rotation_min_deg{-90, -90, -180}, rotation_max_deg{90, 90, 180};
+  std::optional<ParameterSpace::PositionBox> world_box;
 };
 
 struct TrackerConfig {

@@ -25,7 +25,9 @@
 namespace gtrack {
 
 struct Frame {
-  int index = 0;      // position in the source (0-based)
+  // Position in the source (0-based); for a video whose time stamps agree
+  // with its rate, the stamp's (a dropped frame's number is skipped).
+  int index = 0;
   double time_s = 0;  // index / fps
   cv::Mat image;      // BGR, CV_8UC3
   std::string name;   // file name or "frame N", for messages
@@ -36,6 +38,11 @@ struct FrameRange {
   int first = 0;
   int last = -1;
   int every = 1;
+
+  // Whether source index `index` is one the range takes.
+  bool contains(int index) const {
+    return index >= first && (last < 0 || index < last) && (index - first) % (every > 1 ? every : 1) == 0;
+  }
 };
 // Parses "A:B", "A:", ":B" or "A" (A inclusive, B exclusive).
 GTRACK_API FrameRange parse_frame_range(const std::string& text);
@@ -110,9 +117,9 @@ GTRACK_API std::unique_ptr<FrameSource> open_frame_source(const std::string& spe
 // every one after it are decoded from the video's start, with a warning.
 class GTRACK_API RecordedFrames {
  public:
-  // `frames`: the source indices that will be read again, ascending and
-  // `every` apart (the forward run's --frames and --every;
-  // std::invalid_argument otherwise). InputError for a live camera.
+  // `frames`: the source indices that will be read again, ascending and a
+  // multiple of `every` apart (the forward run's --frames and --every, less
+  // any frame missing from a video; std::invalid_argument otherwise). InputError for a live camera.
   RecordedFrames(std::string spec, ImageSize expected, std::vector<int> frames, int every, double fallback_fps);
   // The images of frames[lo], ..., frames[hi - 1], by source index.
   // InputError naming the frame when one can no longer be read, or (a

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -31,6 +32,15 @@ struct ParameterSpace {
   // A periodic parameter wraps into [lower, upper) instead of being clamped
   // (used for rz, whose range is a full turn).
   std::vector<bool> periodic;
+  // A box for x, y, z given in another frame (the world's, when the space
+  // is a turned sensor's): the position p is also kept within it,
+  // origin + axes * (p - origin) in [lower, upper]. None: the bounds alone.
+  struct PositionBox {
+    Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
+  };
+  std::optional<PositionBox> position_box;
 
   int dims() const { return static_cast<int>(names.size()); }
   int fingers() const { return dims() - kPoseDims; }

@@ -78,6 +78,9 @@ struct GTRACK_API SensorFrame {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
 
   bool is_world() const;
+  // A point given in this frame, in the world, and back.
+  Eigen::Vector3d point_to_world(const Eigen::Vector3d& p) const { return origin + axes * (p - origin); }
+  Eigen::Vector3d point_from_world(const Eigen::Vector3d& p) const { return origin + axes.transpose() * (p - origin); }
   // A configuration x, y, z, rx, ry, rz, q.. given in this frame, in the
   // world (joints unchanged), and back.
   Eigen::VectorXd to_world(const Eigen::VectorXd& h) const;

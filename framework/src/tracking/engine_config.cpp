@@ -101,6 +101,11 @@ Eigen::Vector3d vec3(const ConfigTable& t, const char* key, const Eigen::Vector3
 // Whether the box [lo, hi] may hold a point the sensor images: false when all
 // its corners lie outside one of the half-spaces whose intersection is the
 // view (in front of the camera, inside each image border, each clip plane).
+// Corner `k` (0..7) of the box [lo, hi].
+Eigen::Vector3d box_corner(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int k) {
+  return {(k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z()};
+}
+
 bool box_meets_view(const Projection& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   const Eigen::RowVector4d u = p.world_to_image.row(0), v = p.world_to_image.row(1), w = p.world_to_image.row(2);
   std::vector<Eigen::RowVector4d> halves = {w, u, p.size.width * w - u, v, p.size.height * w - v};
@@ -108,9 +113,7 @@ bool box_meets_view(const Projection& p, const Eigen::Vector3d& lo, const Eigen:
   for (const auto& plane : halves) {
     bool any_inside = false;
     for (int corner = 0; corner < 8 && !any_inside; ++corner) {
-      const Eigen::Vector4d x((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
-                              (corner & 4) ? hi.z() : lo.z(), 1.0);
-      any_inside = plane.dot(x) >= 0;
+      any_inside = plane.dot(box_corner(lo, hi, corner).homogeneous()) >= 0;
     }
     if (!any_inside) return false;
   }
@@ -152,18 +155,17 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
                                   vec_text(sensor.nominal_position_mm()) + " mm");
   }
   // The search runs in the sensor's own frame (SensorFrame), which turns
-  // about the nominal position: the default box is the same cube there; a
-  // box given in the world is taken as the box about its corners there.
+  // about the nominal position: the default box is the same cube there. A
+  // box given in the world bounds the search there by the box about its
+  // corners, and the positions searched are kept within the world's box.
   const SensorFrame frame = sensor_frame(sensor);
   if (!frame.is_world() && (t.has("position_min_mm") || t.has("position_max_mm"))) {
+    s.world_box = ParameterSpace::PositionBox{frame.axes, frame.origin, s.position_min_mm, s.position_max_mm};
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d c((corner & 1) ? s.position_max_mm.x() : s.position_min_mm.x(),
-                              (corner & 2) ? s.position_max_mm.y() : s.position_min_mm.y(),
-                              (corner & 4) ? s.position_max_mm.z() : s.position_min_mm.z());
-      const Eigen::Vector3d in_frame = frame.origin + frame.axes.transpose() * (c - frame.origin);
-      lo = lo.cwiseMin(in_frame);
-      hi = hi.cwiseMax(in_frame);
+      const Eigen::Vector3d c = frame.point_from_world(box_corner(s.world_box->lower, s.world_box->upper, corner));
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
     }
     s.position_min_mm = lo;
     s.position_max_mm = hi;
@@ -189,7 +191,26 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
                                  std::to_string(pose.size()));
     }
     const Eigen::VectorXd h = frame.from_world(Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims()));
-    if (!space.contains(h)) t.fail("initial_pose", "lies outside the [search] bounds or the joint limits");
+    if (!space.contains(h)) {
+      // The first value out of its bounds, as the search sees it.
+      std::string why = "its position lies outside the [search] position box";
+      for (int d = 0; d < space.dims(); ++d) {
+        if (!(h[d] >= space.lower[d] && h[d] <= space.upper[d])) {
+          char text[160];
+          std::snprintf(text, sizeof text, "%s is %g, outside [%g, %g]", space.names[d].c_str(), h[d],
+                        space.lower[d], space.upper[d]);
+          why = text;
+          if (d >= 3 && d < kPoseDims && !frame.is_world()) {
+            why += " (the angles taken in the sensor's frame, where this pose is rx, ry, rz = " +
+                   vec_text(h.segment<3>(3)) + " deg; see [search] rotation_min_deg, rotation_max_deg)";
+          } else {
+            why += d < kPoseDims ? " ([search] bounds)" : " (the gripper's joint limits)";
+          }
+          break;
+        }
+      }
+      t.fail("initial_pose", "lies outside what the tracker searches: " + why);
+    }
     c.initial_pose = h;
   }
   c.fps = tracker_fps(t);
@@ -266,6 +287,7 @@ EngineConfig engine_config(const Setup& setup) {
   e.space = ParameterSpace::make(model.fingers(), e.search.position_min_mm, e.search.position_max_mm,
                                  e.search.rotation_min_deg, e.search.rotation_max_deg, g.joint_min_deg,
                                  g.joint_max_deg, full_turn);
+  e.space.position_box = e.search.world_box;
   {
     const ConfigTable t = root.table("tracker");
     e.tracker = read_tracker(t, model, e.space, sensor_frame(*setup.sensor));

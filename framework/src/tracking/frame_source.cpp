@@ -94,9 +94,7 @@ class RangeFilter {
  public:
   explicit RangeFilter(FrameRange r) : r_(r) {}
   bool done(int index) const { return r_.last >= 0 && index >= r_.last; }
-  bool wanted(int index) const {
-    return index >= r_.first && !done(index) && (index - r_.first) % std::max(1, r_.every) == 0;
-  }
+  bool wanted(int index) const { return r_.contains(index); }
 
  private:
   FrameRange r_;
@@ -765,10 +763,14 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
     : spec_(std::move(spec)), expected_(expected), frames_(std::move(frames)), every_(std::max(1, every)),
       fps_(fallback_fps) {
   if (spec_.rfind("camera:", 0) == 0) throw InputError(spec_ + ": a live camera cannot be read again");
+  // Every `every`-th frame, some of them missing (a frame dropped from a
+  // video keeps its number and has no row).
   for (std::size_t k = 1; k < frames_.size(); ++k) {
-    if (frames_[k] - frames_[k - 1] != every_) {
+    const int step = frames_[k] - frames_[k - 1];
+    if (step <= 0 || step % every_ != 0) {
       throw std::invalid_argument("RecordedFrames: frames " + std::to_string(frames_[k - 1]) + " and " +
-                                  std::to_string(frames_[k]) + " are not " + std::to_string(every_) + " apart");
+                                  std::to_string(frames_[k]) + " are not a multiple of " + std::to_string(every_) +
+                                  " apart");
     }
   }
   std::error_code ec;
@@ -786,8 +788,10 @@ std::map<int, cv::Mat> RecordedFrames::fingerprint_in_order(std::size_t lo, std:
   std::vector<std::uint64_t> prints(frames_.size(), 0);
   std::map<int, cv::Mat> block;
   while (auto f = source->next()) {
-    const std::size_t k = static_cast<std::size_t>((f->index - frames_.front()) / every_);
-    if (k >= frames_.size()) break;
+    if (f->index > frames_.back()) break;
+    const auto at = std::lower_bound(frames_.begin(), frames_.end(), f->index);
+    if (*at != f->index) continue;
+    const auto k = static_cast<std::size_t>(at - frames_.begin());
     prints[k] = fingerprint(f->image);
     if (k >= lo && k < hi) block[f->index] = std::move(f->image);
   }
