@@ -65,9 +65,10 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
             << "%), mean " << 100 * s.mean_occlusion << "% of the shape, max " << 100 * s.max_occlusion << "%\n"
             << "  partly out of view (10-99% inside): " << s.partly_out_frames << ", out of view (<10% inside): "
             << s.out_of_view_frames << "\n"
+            << std::defaultfloat << std::setprecision(4)  // readings in any unit: significant digits
             << "  stimulus: " << s.stimulus_min << " to " << s.stimulus_max << unit << " (the profile's range: "
-            << s.stimulus_low << " to " << s.stimulus_high << unit << "), joints: " << s.joint_min_deg << " to "
-            << s.joint_max_deg << " deg\n";
+            << s.stimulus_low << " to " << s.stimulus_high << unit << "), " << std::fixed << std::setprecision(1)
+            << "joints: " << s.joint_min_deg << " to " << s.joint_max_deg << " deg\n";
   // From 2.5 s on, a sequence holds a whole heating and cooling cycle.
   if (s.duration_s >= 2.5 && s.joint_max_deg - s.joint_min_deg < 1) {
     std::cout << "  note: the joints do not fold: the stimulus never crosses the plugin's fold band; set "

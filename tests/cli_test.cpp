@@ -347,6 +347,13 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   const fs::path key = write("fxx.toml", replaced(base, "\nfx = ", "\nfxx = "));
   CliRun r = gtrack("render -c " + key.string() + kParams);
   expect_refusal(r, "key 'sensor.fx': missing; expected a number in (0, 1e+08] (is 'fxx' on line ");
+  // A key read only when present (the camera's calibration file) is known too.
+  const fs::path calibration =
+      write("calibraton.toml", replaced(base, "\nfx = ", "\ncalibraton = \"camera.yml\"\nfx = "));
+  r = gtrack("render -c " + calibration.string() + kParams);
+  EXPECT_NE(r.output.find("key 'sensor.calibraton': unknown key in [sensor] (did you mean 'calibration'?)"),
+            std::string::npos)
+      << r.output;
   // Not fy, its sibling, which is read after it.
   const fs::path sibling = write("focal.toml", replaced(base, "\nfx = ", "\nfocal_length = "));
   r = gtrack("render -c " + sibling.string() + kParams);

@@ -219,6 +219,7 @@ class PinholeMicroscope final : public gtrack::Sensor {
                                   std::to_string(height_) + " image; is the file for another camera?");
       }
     } else {
+      t.mark_used("calibration");  // a known key, for the unknown-key message's list and suggestion
       width_ = static_cast<int>(t.integer("width", Range{1, 65536}));
       height_ = static_cast<int>(t.integer("height", Range{1, 65536}));
       // A focal length of 10^8 pixels sees a hundredth of a micrometre per
