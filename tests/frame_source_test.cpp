@@ -346,6 +346,22 @@ TEST(FrameSource, AFrameDroppedFromAVideoKeepsTheNumbersAfterIt) {
                                    : std::vector<int>({2, 4, 6, 8, 10}));
     EXPECT_NE(warned.find("dropped.avi: frame 5 is missing (the time stamps go on at frame 6"), std::string::npos)
         << warned;
+    EXPECT_EQ(warned.find("reported damage"), std::string::npos) << warned;
+  }
+  // Read again in blocks from its end (the backward pass), with the
+  // dropped frame's number skipped.
+  const std::vector<int> frames = {0, 1, 2, 3, 4, 6, 7, 8, 9, 10, 11};
+  gtrack::RecordedFrames recording(dropped.string(), {128, 96}, frames, 1, 25);
+  for (std::size_t hi = frames.size(); hi > 0; hi -= std::min<std::size_t>(hi, 4)) {
+    const std::size_t lo = hi - std::min<std::size_t>(hi, 4);
+    const auto block = recording.read(lo, hi);
+    ASSERT_EQ(block.size(), hi - lo);
+    for (std::size_t k = lo; k < hi; ++k) {
+      const auto it = block.find(frames[k]);
+      ASSERT_NE(it, block.end()) << "frame " << frames[k];
+      EXPECT_EQ(cv::norm(it->second, reference[static_cast<std::size_t>(frames[k])], cv::NORM_INF), 0)
+          << "frame " << frames[k];
+    }
   }
 }
 

@@ -111,7 +111,8 @@ class VideoSource final : public FrameSource {
               bool live, bool seek = false)
       : cap_(std::move(cap)), name_(std::move(name)), expected_(expected), filter_(range), live_(live) {
     fps_ = cap_.get(cv::CAP_PROP_FPS);
-    if (!(fps_ > 0 && fps_ < 1e4)) fps_ = fallback_fps;
+    rate_declared_ = fps_ > 0 && fps_ < 1e4;
+    if (!rate_declared_) fps_ = fallback_fps;
     count_ = live ? -1 : static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_COUNT));
     if (count_ <= 0 && !live) count_ = -1;
     if (seek && !live && range.first > 0) {
@@ -129,19 +130,33 @@ class VideoSource final : public FrameSource {
     for (;;) {
       if (filter_.done(index_)) return std::nullopt;
       // The decoder's complaints are taken aside: said once, on one line,
-      // when the video ends before its declared frames.
-      detail::CapturedStderr decoder;
-      if (!cap_.grab()) return end_of_stream(decoder.take());
-      follow_time_stamp();
+      // when the video ends before its declared frames. gtrack's own
+      // messages wait until the capture has ended.
+      std::string said;
+      double stamp_ms = -1;
+      {
+        detail::CapturedStderr decoder;
+        const bool grabbed = cap_.grab();
+        if (grabbed) stamp_ms = cap_.get(cv::CAP_PROP_POS_MSEC);
+        said = decoder.take();
+        if (!grabbed) return end_of_stream(said);
+      }
+      follow_time_stamp(stamp_ms);
       if (filter_.done(index_)) return std::nullopt;
       if (!filter_.wanted(index_)) {  // grabbed, never decoded into an image
-        note(decoder.take(), false);
+        note(said, false);
         ++index_;
         continue;
       }
       cv::Mat img;
-      if (!cap_.retrieve(img) || img.empty()) return end_of_stream(decoder.take());
-      note(decoder.take(), true);
+      bool decoded = false;
+      {
+        detail::CapturedStderr decoder;
+        decoded = cap_.retrieve(img) && !img.empty();
+        if (const std::string more = decoder.take(); !more.empty()) said += (said.empty() ? "" : "; ") + more;
+      }
+      if (!decoded) return end_of_stream(said);
+      note(said, true);
       Frame f;
       f.index = index_++;
       f.time_s = fps_ > 0 ? f.index / fps_ : 0.0;
@@ -176,19 +191,26 @@ class VideoSource final : public FrameSource {
   }
   // A frame missing from a recording (capture software writes a dropped
   // frame as an empty chunk, which decoding skips) would shift the number
-  // of every frame after it. The frame just taken is numbered by its time
-  // stamp instead, counted from the first frame's, and the first gap is
-  // warned about. True when the number moved.
+  // of every frame after it. The frame just taken, at `ms` (its time stamp,
+  // from the stream's start), is numbered by its time stamp instead,
+  // counted from the first frame's, and the first gap is warned about.
+  // True when the number moved.
   //
-  // Only while the stamps agree with the declared rate: the first two
-  // frames must be one frame apart. A video whose stamps run at another
-  // rate than it declares (a variable-rate recording whose declared rate is
-  // the time base's) is numbered by order, as before.
-  bool follow_time_stamp() {
-    if (live_ || !(fps_ > 0) || stamps_disagree_) return false;
-    const double ms = cap_.get(cv::CAP_PROP_POS_MSEC);
-    if (!std::isfinite(ms) || ms < 0) return false;
-    const long long stamp = std::llround(ms * fps_ / 1000.0);
+  // Only while the stamps are those of the rate the video declares: the
+  // first two frames one frame apart, every frame on that rate's grid, and
+  // a gap within the video's declared frames. Otherwise (a variable-rate
+  // recording, a rate the container does not give, a jump in the stamps)
+  // the frames are numbered by their order from there on, as before.
+  bool follow_time_stamp(double ms) {
+    if (live_ || !rate_declared_ || stamps_disagree_ || !std::isfinite(ms) || ms < 0 || ms > 1e12) return false;
+    const double exact = ms * fps_ / 1000.0;
+    const long long stamp = std::llround(exact);
+    const auto disagree = [&](const char* why) {
+      stamps_disagree_ = true;
+      logger().debug("{}: frame {}: {}; frames are numbered by their order", name_, index_, why);
+      return false;
+    };
+    if (std::abs(exact - static_cast<double>(stamp)) > 0.1) return disagree("time stamp off the declared rate's grid");
     if (!stamp_base_) {
       stamp_base_ = stamp - index_;
       return false;
@@ -196,14 +218,10 @@ class VideoSource final : public FrameSource {
     const long long source = stamp - *stamp_base_;
     if (!stamps_checked_) {
       stamps_checked_ = true;
-      if (source != index_) {
-        stamps_disagree_ = true;
-        logger().debug("{}: time stamps not one frame apart at {} frames/s; frames numbered by their order", name_,
-                       fps_);
-        return false;
-      }
+      if (source != index_) return disagree("the first two time stamps are not one frame apart");
     }
-    if (source <= index_ || source > std::numeric_limits<int>::max()) return false;
+    if (source <= index_) return false;
+    if (source - index_ > kMaxGap || (count_ > 0 && source >= count_)) return disagree("time stamps jump too far");
     if (!warned_gap_) {
       logger().warn("{}: frame {} is missing (the time stamps go on at frame {}, {:.1f} ms): frames are numbered "
                     "by their time stamps, so that each keeps the source's number; later gaps are not warned about",
@@ -213,6 +231,7 @@ class VideoSource final : public FrameSource {
     index_ = static_cast<int>(source);
     return true;
   }
+  static constexpr long long kMaxGap = 1000;  // frames: more is a jump in the stamps, not dropped frames
   std::optional<Frame> end_of_stream(const std::string& said) {
     // A video that opens but yields nothing is as unusable as one that does not open.
     if (index_ == 0 && delivered_ == 0 && !live_) {
@@ -241,7 +260,7 @@ class VideoSource final : public FrameSource {
   int delivered_ = 0;
   bool seeked_ = false;
   bool warned_damage_ = false, warned_gap_ = false;
-  bool stamps_checked_ = false, stamps_disagree_ = false;
+  bool rate_declared_ = false, stamps_checked_ = false, stamps_disagree_ = false;
   std::optional<long long> stamp_base_;  // the first frame's time stamp in frames, less its number
   std::string last_said_;
   std::string ended_early_;
