@@ -703,7 +703,7 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
   r = load();
   gtrack::track_sequence(r.setup, r.config, second);
   gtrack::logger().sinks().pop_back();
-  EXPECT_NE(log.str().find("overlay.mp4: cannot be read (a video is whole only once it is closed"), std::string::npos)
+  EXPECT_NE(log.str().find("overlay.mp4: cannot be read (not closed by the run that wrote it"), std::string::npos)
       << log.str();
 }
 

@@ -121,7 +121,7 @@ class GTRACK_API Tracker {
 
   // Forget the history: the next frame starts like the first.
   void reset();
-  // The history, in the frame the tracker searches in (see below).
+  // The history, in the frame the tracker searches in (the class comment).
   TrackerState state() const;
   // Continue from a state (of a tracker with the same setup and config);
   // gtrack::Error when its configurations are not of this setup's size.
@@ -153,6 +153,9 @@ class GTRACK_API Tracker {
   // in the bottom-right corner.
   cv::Mat draw_overlay(const cv::Mat& frame, const Estimate& estimate) const;
 
+  // The renderer, config and space the search uses: in the sensor's frame,
+  // like the configurations they take (for a sensor looking down world z,
+  // the world's).
   Renderer& renderer();
   const EngineConfig& config() const;
   const ParameterSpace& space() const;

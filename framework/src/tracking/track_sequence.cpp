@@ -74,23 +74,25 @@ class OverlayWriter {
 
 // The overlays of the runs before a resumed one: a video killed before it
 // was closed (kill -9, a crash, a power loss) may not open at all (an mp4
-// has no index until it is closed), which is said once per file.
-void check_earlier_overlays(const fs::path& dir) {
+// has no index until it is closed), which is said once per file. `own`:
+// the file this run is about to write.
+void check_earlier_overlays(const fs::path& dir, const std::string& own) {
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind("overlay", 0) != 0 || !entry.is_regular_file(ec)) continue;
-    cv::VideoCapture video;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind("overlay", 0) != 0 || name.rfind(own + ".", 0) == 0 || !it->is_regular_file(ec)) continue;
+    bool readable = false;
     {
       detail::CapturedStderr decoder;  // "moov atom not found"
-      video.open(entry.path().string());
+      cv::VideoCapture video(it->path().string());
+      cv::Mat first;
+      readable = video.isOpened() && video.read(first) && !first.empty();
     }
-    cv::Mat first;
-    if (video.isOpened() && video.read(first) && !first.empty()) continue;
-    logger().warn("{}: cannot be read (a video is whole only once it is closed, and the run that wrote it was "
-                  "stopped without closing it); the frames it held have no overlay (a run without --resume draws "
-                  "them all again)",
-                  entry.path().string());
+    if (readable) continue;
+    logger().warn("{}: cannot be read (not closed by the run that wrote it, which was stopped by kill -9, a crash "
+                  "or a power loss, or no decoder for it here); the frames it held have no overlay (a run without "
+                  "--resume draws them all again)",
+                  it->path().string());
   }
 }
 
@@ -178,6 +180,7 @@ bool warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o, boo
 
 TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
   const auto start = Clock::now();
+  const SensorFrame view = sensor_frame(*setup.sensor);  // symmetric equivalents are compared in it
   // Inputs are checked before anything is written.
   {
     std::error_code ec;
@@ -336,9 +339,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                   options.out_dir.string());
   }
   const bool want_overlay = options.overlay.value_or(config.tracker.overlay);
-  if (resumed && want_overlay) check_earlier_overlays(options.out_dir);
   char overlay_stem[48] = "overlay";
   if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", range.first);
+  if (resumed && want_overlay) check_earlier_overlays(options.out_dir, overlay_stem);
   OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem);
   Progress progress(options.progress, expected_frames(*source, range), config.tracker.progress_every);
 
@@ -393,7 +396,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     previous_index = frame->index;
     if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
       // Of the reference's symmetric equivalents, the one nearest the estimate.
-      const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis);
+      const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis, view);
       e.reference_terms = tracker.score(reference);
       ++references_used;
     }

@@ -66,7 +66,8 @@ std::string smoothing_report(const TwoPassSummary& summary) {
   return text;
 }
 
-double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma) {
+double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma,
+                           const SensorFrame& frame) {
   if (!(sigma > 0) || rows.empty()) return 0;
   const std::size_t n = rows.size();
   // Each row as its symmetric equivalent nearest the previous row's.
@@ -76,7 +77,7 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
   std::optional<std::size_t> previous;
   for (std::size_t i = 0; i < n; ++i) {
     if (rows[i].status == TrackStatus::Lost) continue;
-    aligned[i] = previous ? detail::nearest_equivalent(model, rows[i].hypothesis, aligned[*previous]) : rows[i].hypothesis;
+    aligned[i] = previous ? detail::nearest_equivalent(model, rows[i].hypothesis, aligned[*previous], frame) : rows[i].hypothesis;
     q[i] = Eigen::Quaterniond(rotation_from_euler_deg(aligned[i][3], aligned[i][4], aligned[i][5]));
     used[i] = true;
     previous = i;
@@ -135,7 +136,7 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
     h.segment<3>(3) = euler_deg_from_rotation(fitted.toRotationMatrix());
     change += a.norm() * 180.0 / std::numbers::pi;
     ++changed;
-    out[i] = detail::nearest_equivalent(model, h, rows[i].hypothesis);
+    out[i] = detail::nearest_equivalent(model, h, rows[i].hypothesis, frame);
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (used[i]) rows[i].hypothesis = out[i];
@@ -172,6 +173,7 @@ std::vector<int> cheapest_path(const std::vector<std::array<std::array<double, 2
 TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                         const std::vector<Estimate>& forward) {
   const auto start = std::chrono::steady_clock::now();
+  const SensorFrame view = sensor_frame(*setup.sensor);  // symmetric equivalents are compared in it
   if (options.input.rfind("camera:", 0) == 0) {
     throw InputError("the backward pass goes back over a recording, not a live camera (" + options.input + ")");
   }
@@ -283,7 +285,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     if (e.hypothesis != f.hypothesis) ++differ;
     const Estimate& b = backward[k];
     if (b.status != TrackStatus::Lost) {
-      const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
+      const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis, view);
       node[k][1] = without_temporal(forward_again.score(b_here));
     }
     if (e.status != TrackStatus::Lost || b.status == TrackStatus::Lost) node[k][0] = without_temporal(e.terms);
@@ -300,7 +302,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
         edge[k][from][to] = node[k][to];
         if (k == 0 || node[k][to] == kNone || candidate(k - 1, from).status == TrackStatus::Lost) continue;
         const Eigen::VectorXd h =
-            to == 0 ? e.hypothesis : detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
+            to == 0 ? e.hypothesis : detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis, view);
         edge[k][from][to] = without_temporal(forward_again.score_after(h, candidate(k - 1, from).hypothesis));
       }
     }
@@ -323,7 +325,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // mirror), the estimate that continues its neighbours' is taken.
   const auto step = [&](std::size_t i, int from, int to) {
     const Eigen::VectorXd& h = candidate(i, to).hypothesis;
-    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate(i - 1, from).hypothesis, h);
+    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate(i - 1, from).hypothesis, h, view);
     return lt * forward_again.temporal_term(h, before);
   };
   std::vector<std::array<std::array<double, 2>, 2>> costs(forward.size());
@@ -347,7 +349,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // the neighbouring frames' estimates average out; the orientation, the
   // weakly seen part of it, is averaged over a few frames (docs/tracker.md).
   summary.smoothed = config.tracker.two_pass_smoothing > 0;
-  summary.smoothing_change_deg = smooth_orientations(setup.model(), taken, config.tracker.two_pass_smoothing);
+  summary.smoothing_change_deg = smooth_orientations(setup.model(), taken, config.tracker.two_pass_smoothing, view);
   ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
   for (const Estimate& e : taken) two_pass_results.write(e);
   two_pass_results.close();
