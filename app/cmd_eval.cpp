@@ -182,6 +182,24 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   so.plugin_paths = common.plugin_paths;
   so.with_stimulus = false;
   gtrack::Setup setup = gtrack::load_setup(config, so);
+  // The run that wrote the estimates kept its config beside them: a sensor
+  // posed otherwise there splits the errors along other axes than the run's.
+  const fs::path run_config = estimates_file.parent_path() / "run_config.toml";
+  std::error_code same_ec;
+  if (fs::is_regular_file(run_config, same_ec) && !fs::equivalent(run_config, config, same_ec)) {
+    try {
+      const gtrack::Projection ran = gtrack::load_setup(run_config, so).sensor->projection();
+      const gtrack::Projection here = setup.sensor->projection();
+      if (!ran.world_to_image.isApprox(here.world_to_image, 1e-9) || ran.size.width != here.size.width ||
+          ran.size.height != here.size.height) {
+        gtrack::logger().warn("{}: its [sensor] images the world otherwise than {}'s (a sensor posed or sized "
+                              "otherwise): the errors are measured along {}'s axes, and the in-view shares from it",
+                              run_config.string(), config.string(), config.string());
+      }
+    } catch (const std::exception&) {
+      // A run config this machine cannot load (its plugins elsewhere) is no evidence either way.
+    }
+  }
   for (const auto& k : setup.root.keys()) setup.root.mark_used(k);  // engine tables are not used here
 
   gtrack::EvalOptions opt;

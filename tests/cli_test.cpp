@@ -513,10 +513,13 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
     for (int k = 0; k < 3; ++k) l = l.substr(0, l.rfind(','));
     if (line == 0 || line % 2 == 0) text += l + "\n";
   }
-  const fs::path estimates = write("every_other.csv", text);
+  fs::create_directories(dir / "run");
+  const fs::path estimates = dir / "run" / "estimates.csv";
+  std::ofstream(estimates) << text;
   const std::string eval = "eval -t " + (dir / "ground_truth.csv").string() + " -e " + estimates.string();
   CliRun r = gtrack(eval);
   EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("images the world otherwise"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("4 frames of"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(--frames 1: --every 2), evaluate with the same options"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("lost in all 4 (missing 4)"), std::string::npos) << r.output;
@@ -528,6 +531,11 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   r = gtrack(eval + " --frames 7:");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--frames/--every select none of the frames of"), std::string::npos) << r.output;
+  // The run's own config beside the estimates, with another camera: said.
+  std::ofstream(dir / "run" / "run_config.toml") << replaced(read_file(dir / "sequence.toml"), "\nfx = ", "\nfx = 2");
+  r = gtrack(eval);
+  EXPECT_NE(r.output.find("run_config.toml: its [sensor] images the world otherwise than"), std::string::npos)
+      << r.output;
 }
 
 TEST(Cli, EvalRefusesMalformedTables) {
