@@ -194,33 +194,31 @@ class VideoSource final : public FrameSource {
   // of every frame after it. The frame just taken, at `ms` (its time stamp,
   // from the stream's start), is numbered by its time stamp instead,
   // counted from the first frame's, and the first gap is warned about.
-  // True when the number moved.
   //
   // Only while the stamps are those of the rate the video declares: the
   // first two frames one frame apart, every frame on that rate's grid, and
   // a gap within the video's declared frames. Otherwise (a variable-rate
   // recording, a rate the container does not give, a jump in the stamps)
   // the frames are numbered by their order from there on, as before.
-  bool follow_time_stamp(double ms) {
-    if (live_ || !rate_declared_ || stamps_disagree_ || !std::isfinite(ms) || ms < 0 || ms > 1e12) return false;
+  void follow_time_stamp(double ms) {
+    if (live_ || !rate_declared_ || stamps_disagree_ || !std::isfinite(ms) || ms < 0 || ms > 1e12) return;
     const double exact = ms * fps_ / 1000.0;
     const long long stamp = std::llround(exact);
     const auto disagree = [&](const char* why) {
       stamps_disagree_ = true;
       logger().debug("{}: frame {}: {}; frames are numbered by their order", name_, index_, why);
-      return false;
     };
     if (std::abs(exact - static_cast<double>(stamp)) > 0.1) return disagree("time stamp off the declared rate's grid");
     if (!stamp_base_) {
       stamp_base_ = stamp - index_;
-      return false;
+      return;
     }
     const long long source = stamp - *stamp_base_;
     if (!stamps_checked_) {
       stamps_checked_ = true;
       if (source != index_) return disagree("the first two time stamps are not one frame apart");
     }
-    if (source <= index_) return false;
+    if (source <= index_) return;
     if (source - index_ > kMaxGap || (count_ > 0 && source >= count_)) return disagree("time stamps jump too far");
     if (!warned_gap_) {
       logger().warn("{}: frame {} is missing (the time stamps go on at frame {}, {:.1f} ms): frames are numbered "
@@ -229,7 +227,6 @@ class VideoSource final : public FrameSource {
       warned_gap_ = true;
     }
     index_ = static_cast<int>(source);
-    return true;
   }
   static constexpr long long kMaxGap = 1000;  // frames: more is a jump in the stamps, not dropped frames
   std::optional<Frame> end_of_stream(const std::string& said) {
