@@ -8,12 +8,11 @@ namespace gtrack {
 
 namespace {
 
-// `h` with its position moved by `point` and its orientation turned by `axes`.
-template <class Point>
-Eigen::VectorXd turned(const Eigen::VectorXd& h, const Eigen::Matrix3d& axes, Point point) {
+// `h` at `position`, its orientation turned by `turn`, its joints as they are.
+Eigen::VectorXd moved(const Eigen::VectorXd& h, const Eigen::Vector3d& position, const Eigen::Matrix3d& turn) {
   Eigen::VectorXd out = h;
-  out.head<3>() = point(Eigen::Vector3d(h.head<3>()));
-  out.segment<3>(3) = euler_deg_from_rotation(axes * rotation_from_euler_deg(h[3], h[4], h[5]));
+  out.head<3>() = position;
+  out.segment<3>(3) = euler_deg_from_rotation(turn * rotation_from_euler_deg(h[3], h[4], h[5]));
   return out;
 }
 
@@ -64,11 +63,11 @@ Eigen::Vector3d viewing_axis(const Projection& projection) {
 bool SensorFrame::is_world() const { return (axes - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12; }
 
 Eigen::VectorXd SensorFrame::to_world(const Eigen::VectorXd& h) const {
-  return is_world() ? h : turned(h, axes, [this](const Eigen::Vector3d& p) { return point_to_world(p); });
+  return is_world() ? h : moved(h, point_to_world(h.head<3>()), axes);
 }
 
 Eigen::VectorXd SensorFrame::from_world(const Eigen::VectorXd& h) const {
-  return is_world() ? h : turned(h, axes.transpose(), [this](const Eigen::Vector3d& p) { return point_from_world(p); });
+  return is_world() ? h : moved(h, point_from_world(h.head<3>()), axes.transpose());
 }
 
 SensorFrame sensor_frame(const Sensor& sensor) {
