@@ -59,8 +59,8 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
   std::string unit;
   if (setup.stimulus) unit.append(" ").append(setup.stimulus->reading_unit());
-  std::cout << std::fixed << std::setprecision(1) << "synthetic sequence: " << s.frames << " frames (preset " << o.preset << ", seed " << o.seed << ") in "
-            << s.seconds << " s -> " << out.string() << "\n"
+  std::cout << std::fixed << std::setprecision(1) << "synthetic sequence: " << s.frames << " frames (preset "
+            << o.preset << ", seed " << o.seed << ") in " << s.seconds << " s -> " << out.string() << "\n"
             << "  occluded frames: " << s.occluded_frames << " (" << 100.0 * s.occluded_frames / s.frames
             << "%), mean " << 100 * s.mean_occlusion << "% of the shape, max " << 100 * s.max_occlusion << "%\n"
             << "  partly out of view (10-99% inside): " << s.partly_out_frames << ", out of view (<10% inside): "
