@@ -184,11 +184,16 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   gtrack::Setup setup = gtrack::load_setup(config, so);
   // The run that wrote the estimates kept its config beside them: a sensor
   // posed otherwise there splits the errors along other axes than the run's.
-  const fs::path run_config = estimates_file.parent_path() / "run_config.toml";
+  // (A two-pass table is in the run's folder's two_pass/ or backward/.)
+  fs::path run_config = estimates_file.parent_path() / "run_config.toml";
   std::error_code same_ec;
+  if (!fs::is_regular_file(run_config, same_ec)) run_config = estimates_file.parent_path().parent_path() / "run_config.toml";
   if (fs::is_regular_file(run_config, same_ec) && !fs::equivalent(run_config, config, same_ec)) {
+    const auto level = gtrack::logger().level();
     try {
+      gtrack::logger().set_level(spdlog::level::off);  // what loading it says was said when it ran
       const gtrack::Projection ran = gtrack::load_setup(run_config, so).sensor->projection();
+      gtrack::logger().set_level(level);
       const gtrack::Projection here = setup.sensor->projection();
       if (!ran.world_to_image.isApprox(here.world_to_image, 1e-9) || ran.size.width != here.size.width ||
           ran.size.height != here.size.height) {
@@ -198,6 +203,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
       }
     } catch (const std::exception&) {
       // A run config this machine cannot load (its plugins elsewhere) is no evidence either way.
+      gtrack::logger().set_level(level);
     }
   }
   for (const auto& k : setup.root.keys()) setup.root.mark_used(k);  // engine tables are not used here

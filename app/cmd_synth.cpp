@@ -65,7 +65,7 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
             << "%), mean " << 100 * s.mean_occlusion << "% of the shape, max " << 100 * s.max_occlusion << "%\n"
             << "  partly out of view (10-99% inside): " << s.partly_out_frames << ", out of view (<10% inside): "
             << s.out_of_view_frames << "\n"
-            << std::defaultfloat << std::setprecision(4)  // readings in any unit: significant digits
+            << std::defaultfloat << std::setprecision(6)  // readings in any unit: significant digits
             << "  stimulus: " << s.stimulus_min << " to " << s.stimulus_max << unit << " (the profile's range: "
             << s.stimulus_low << " to " << s.stimulus_high << unit << "), " << std::fixed << std::setprecision(1)
             << "joints: " << s.joint_min_deg << " to " << s.joint_max_deg << " deg\n";

@@ -359,6 +359,7 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   r = gtrack("render -c " + sibling.string() + kParams);
   EXPECT_NE(r.output.find("key 'sensor.fx': missing"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("is 'fy'"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("is 'cx'"), std::string::npos) << r.output;
   const fs::path plugin =
       write("plugn.toml", replaced(base, "plugin = \"hydrogel_six_finger\"", "plugn = \"hydrogel_six_finger\""));
   r = gtrack("render -c " + plugin.string() + kParams);

@@ -1104,7 +1104,7 @@ TEST(EngineConfig, ATurnedSensorsSearchStaysInTheWorldBox) {
     gtrack::engine_config(gtrack::testing::probe_setup("[30, 45, 10]", box + pose));
     ADD_FAILURE() << "an initial pose outside the world box was taken";
   } catch (const gtrack::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("its position lies outside the [search] position box"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("x_mm is 16, outside [11, 14] ([search] bounds)"), std::string::npos)
         << e.what();
   }
   // A probe looking down world -z sees a gripper lying flat edge-on (rx =

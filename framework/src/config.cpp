@@ -500,14 +500,13 @@ std::vector<std::string> ConfigTable::strings_or(std::string_view key, std::vect
 
 std::string ConfigTable::misspelling_hint(std::string_view key) const {
   if (!impl_->table) return {};
-  // Two-letter keys come in families that differ in the last letter (fx,
-  // fy; cx, cy): such an unread one is more likely a key still to be read
+  // Two-letter keys come in families one letter apart (fx, fy, cx, cy): an
+  // unread one of the same length is more likely a key still to be read
   // than a typo.
   std::vector<std::string> unread;
   for (auto&& [k, v] : *impl_->table) {
     const std::string_view name = k.str();
-    const bool sibling = key.size() <= 2 && name.size() == key.size() &&
-                         name.substr(0, name.size() - 1) == key.substr(0, key.size() - 1);
+    const bool sibling = key.size() <= 2 && name.size() == key.size();
     if (!impl_->used->count(std::string(name)) && name != key && !sibling) unread.emplace_back(name);
   }
   const auto m = closest_match(key, unread);

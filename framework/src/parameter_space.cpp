@@ -10,7 +10,11 @@
 namespace gtrack {
 
 void ParameterSpace::clamp(Eigen::Ref<Eigen::VectorXd> h) const {
-  for (int i = 0; i < dims(); ++i) {
+  const int boxed = position_box && h.size() >= 3 ? 3 : 0;  // x, y, z go to the box below
+  for (int i = 0; i < boxed; ++i) {
+    if (!std::isfinite(h[i])) h[i] = 0.5 * (lower[i] + upper[i]);
+  }
+  for (int i = boxed; i < dims(); ++i) {
     double& v = h[i];
     if (!std::isfinite(v)) v = 0.5 * (lower[i] + upper[i]);
     if (periodic[i]) {
@@ -20,22 +24,24 @@ void ParameterSpace::clamp(Eigen::Ref<Eigen::VectorXd> h) const {
       v = std::min(std::max(v, lower[i]), upper[i]);
     }
   }
-  if (position_box && h.size() >= 3) {
+  if (boxed) {
+    // The nearest point of the turned box, then within the bounds for the
+    // turn's rounding (the bounds hold the box).
     const PositionBox& b = *position_box;
-    const Eigen::Vector3d p = h.head<3>();
-    const Eigen::Vector3d q = (b.origin + b.axes * (p - b.origin)).cwiseMax(b.lower).cwiseMin(b.upper);
-    h.head<3>() = (b.origin + b.axes.transpose() * (q - b.origin)).cwiseMax(lower.head<3>()).cwiseMin(upper.head<3>());
+    const Eigen::Vector3d q = b.to_box(h.head<3>()).cwiseMax(b.lower).cwiseMin(b.upper);
+    h.head<3>() = b.from_box(q).cwiseMax(lower.head<3>()).cwiseMin(upper.head<3>());
   }
 }
 
 bool ParameterSpace::contains(const Eigen::Ref<const Eigen::VectorXd>& h) const {
   if (h.size() != dims()) return false;
   for (int i = 0; i < dims(); ++i) {
-    if (!std::isfinite(h[i]) || h[i] < lower[i] || h[i] > upper[i]) return false;
+    if (!std::isfinite(h[i])) return false;
+    if (!periodic[i] && (h[i] < lower[i] || h[i] > upper[i])) return false;
   }
   if (position_box && h.size() >= 3) {
     const PositionBox& b = *position_box;
-    const Eigen::Vector3d q = b.origin + b.axes * (h.head<3>() - b.origin);
+    const Eigen::Vector3d q = b.to_box(h.head<3>());
     constexpr double kSlack = 1e-9;  // mm: the turn's rounding
     if (((q - b.lower).array() < -kSlack).any() || ((q - b.upper).array() > kSlack).any()) return false;
   }

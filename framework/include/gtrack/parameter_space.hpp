@@ -39,14 +39,20 @@ struct ParameterSpace {
     Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
     Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
+
+    Eigen::Vector3d to_box(const Eigen::Vector3d& p) const { return origin + axes * (p - origin); }
+    Eigen::Vector3d from_box(const Eigen::Vector3d& q) const { return origin + axes.transpose() * (q - origin); }
   };
   std::optional<PositionBox> position_box;
 
   int dims() const { return static_cast<int>(names.size()); }
   int fingers() const { return dims() - kPoseDims; }
 
-  // Puts h on the nearest point inside the bounds (wrapping periodic ones).
+  // Puts h on the nearest point inside the bounds (wrapping periodic ones;
+  // the position on the nearest point of position_box when there is one).
   GTRACK_API void clamp(Eigen::Ref<Eigen::VectorXd> h) const;
+  // Whether h is inside the bounds; a periodic parameter is inside at any
+  // finite value (it wraps).
   GTRACK_API bool contains(const Eigen::Ref<const Eigen::VectorXd>& h) const;
 
   // Pose bounds from the engine config and joint bounds from the gripper.

@@ -98,14 +98,14 @@ Eigen::Vector3d vec3(const ConfigTable& t, const char* key, const Eigen::Vector3
   return {v[0], v[1], v[2]};
 }
 
-// Whether the box [lo, hi] may hold a point the sensor images: false when all
-// its corners lie outside one of the half-spaces whose intersection is the
-// view (in front of the camera, inside each image border, each clip plane).
 // Corner `k` (0..7) of the box [lo, hi].
 Eigen::Vector3d box_corner(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int k) {
   return {(k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z()};
 }
 
+// Whether the box [lo, hi] may hold a point the sensor images: false when all
+// its corners lie outside one of the half-spaces whose intersection is the
+// view (in front of the camera, inside each image border, each clip plane).
 bool box_meets_view(const Projection& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   const Eigen::RowVector4d u = p.world_to_image.row(0), v = p.world_to_image.row(1), w = p.world_to_image.row(2);
   std::vector<Eigen::RowVector4d> halves = {w, u, p.size.width * w - u, v, p.size.height * w - v};
@@ -173,6 +173,38 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
   return s;
 }
 
+// Why a configuration, `given` in the world and `h` in the sensor's frame,
+// lies outside `space`: its first value out of its bounds, in the terms the
+// config gives them (positions in the world, angles in the sensor's frame).
+std::string outside(const ParameterSpace& space, const SensorFrame& frame, const Eigen::VectorXd& given,
+                    const Eigen::VectorXd& h) {
+  const auto out_of = [&](int d, double v, double lo, double hi, const std::string& where) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%s is %g, outside [%g, %g]", space.names[d].c_str(), v, lo, hi);
+    return text + (" (" + where + ")");
+  };
+  for (int d = 0; d < 3; ++d) {
+    if (const auto& box = space.position_box) {
+      if (given[d] < box->lower[d] || given[d] > box->upper[d]) {
+        return out_of(d, given[d], box->lower[d], box->upper[d], "[search] bounds");
+      }
+    } else if (h[d] < space.lower[d] || h[d] > space.upper[d]) {
+      if (frame.is_world()) return out_of(d, h[d], space.lower[d], space.upper[d], "[search] bounds");
+      return "its position lies outside the default [search] box, the cube about the sensor's nominal position " +
+             vec_text(frame.origin) + " mm in the sensor's frame";
+    }
+  }
+  for (int d = 3; d < space.dims(); ++d) {
+    if (space.periodic[d] || (h[d] >= space.lower[d] && h[d] <= space.upper[d])) continue;
+    if (d >= kPoseDims) return out_of(d, h[d], space.lower[d], space.upper[d], "the gripper's joint limits");
+    if (frame.is_world()) return out_of(d, h[d], space.lower[d], space.upper[d], "[search] bounds");
+    return out_of(d, h[d], space.lower[d], space.upper[d],
+                  "the angles taken in the sensor's frame, where this pose is rx, ry, rz = " +
+                      vec_text(h.segment<3>(3)) + " deg; see [search] rotation_min_deg, rotation_max_deg");
+  }
+  return "a value is not a finite number";
+}
+
 TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, const ParameterSpace& space,
                            const SensorFrame& frame) {
   TrackerConfig c;
@@ -190,27 +222,9 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
                                  " values x,y,z (mm), rx,ry,rz (deg), q1..qF (deg), got " +
                                  std::to_string(pose.size()));
     }
-    const Eigen::VectorXd h = frame.from_world(Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims()));
-    if (!space.contains(h)) {
-      // The first value out of its bounds, as the search sees it.
-      std::string why = "its position lies outside the [search] position box";
-      for (int d = 0; d < space.dims(); ++d) {
-        if (!(h[d] >= space.lower[d] && h[d] <= space.upper[d])) {
-          char text[160];
-          std::snprintf(text, sizeof text, "%s is %g, outside [%g, %g]", space.names[d].c_str(), h[d],
-                        space.lower[d], space.upper[d]);
-          why = text;
-          if (d >= 3 && d < kPoseDims && !frame.is_world()) {
-            why += " (the angles taken in the sensor's frame, where this pose is rx, ry, rz = " +
-                   vec_text(h.segment<3>(3)) + " deg; see [search] rotation_min_deg, rotation_max_deg)";
-          } else {
-            why += d < kPoseDims ? " ([search] bounds)" : " (the gripper's joint limits)";
-          }
-          break;
-        }
-      }
-      t.fail("initial_pose", "lies outside what the tracker searches: " + why);
-    }
+    const Eigen::VectorXd given = Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims());
+    const Eigen::VectorXd h = frame.from_world(given);
+    if (!space.contains(h)) t.fail("initial_pose", "lies outside what the tracker searches: " + outside(space, frame, given, h));
     c.initial_pose = h;
   }
   c.fps = tracker_fps(t);

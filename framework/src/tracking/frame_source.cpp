@@ -134,13 +134,14 @@ class VideoSource final : public FrameSource {
       // messages wait until the capture has ended.
       std::string said;
       double stamp_ms = -1;
+      bool grabbed = false;
       {
         detail::CapturedStderr decoder;
-        const bool grabbed = cap_.grab();
+        grabbed = cap_.grab();
         if (grabbed) stamp_ms = cap_.get(cv::CAP_PROP_POS_MSEC);
         said = decoder.take();
-        if (!grabbed) return end_of_stream(said);
       }
+      if (!grabbed) return end_of_stream(said);
       follow_time_stamp(stamp_ms);
       if (filter_.done(index_)) return std::nullopt;
       if (!filter_.wanted(index_)) {  // grabbed, never decoded into an image
@@ -196,9 +197,9 @@ class VideoSource final : public FrameSource {
   // counted from the first frame's, and the first gap is warned about.
   //
   // Only while the stamps are those of the rate the video declares: the
-  // first two frames one frame apart, every frame on that rate's grid, and
-  // a gap within the video's declared frames. Otherwise (a variable-rate
-  // recording, a rate the container does not give, a jump in the stamps)
+  // first two frames one frame apart, every frame on that rate's grid,
+  // never back, and a gap of at most kMaxGap frames. Otherwise (a
+  // variable-rate recording, a rate the container does not give, a jump)
   // the frames are numbered by their order from there on, as before.
   void follow_time_stamp(double ms) {
     if (live_ || !rate_declared_ || stamps_disagree_ || !std::isfinite(ms) || ms < 0 || ms > 1e12) return;
@@ -218,8 +219,9 @@ class VideoSource final : public FrameSource {
       stamps_checked_ = true;
       if (source != index_) return disagree("the first two time stamps are not one frame apart");
     }
-    if (source <= index_) return;
-    if (source - index_ > kMaxGap || (count_ > 0 && source >= count_)) return disagree("time stamps jump too far");
+    if (source == index_) return;
+    if (source < index_) return disagree("a time stamp goes back");
+    if (source - index_ > kMaxGap) return disagree("time stamps jump too far");
     if (!warned_gap_) {
       logger().warn("{}: frame {} is missing (the time stamps go on at frame {}, {:.1f} ms): frames are numbered "
                     "by their time stamps, so that each keeps the source's number; later gaps are not warned about",
@@ -887,6 +889,9 @@ FrameRange parse_frame_range(const std::string& text) {
   const auto colon = text.find(':');
   if (colon == std::string::npos) {
     parse_int(text, r.first);
+    if (r.first == std::numeric_limits<int>::max()) {
+      throw InputError("--frames '" + text + "': expected a frame index below " + std::to_string(r.first));
+    }
     r.last = r.first + 1;
     return r;
   }
