@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include "gtrack/error.hpp"
 #include "gtrack/frame_source.hpp"
@@ -84,7 +85,11 @@ void check_earlier_overlays(const fs::path& dir, const std::string& own) {
     bool readable = false;
     {
       detail::CapturedStderr decoder;  // "moov atom not found"
-      cv::VideoCapture video(it->path().string());
+      // FFmpeg, as the overlay was written and as inputs are read: any
+      // backend would also try the camera libraries on a damaged file.
+      cv::VideoCapture video;
+      video.open(it->path().string(),
+                 cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY);
       cv::Mat first;
       readable = video.isOpened() && video.read(first) && !first.empty();
     }
