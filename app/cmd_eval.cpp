@@ -151,6 +151,38 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
   }
 }
 
+// The run that wrote the estimates kept its config beside them (a two-pass
+// table: in the run's folder's two_pass/ or backward/): a sensor posed or
+// sized otherwise there splits the errors along other axes than the run's.
+void warn_if_the_run_imaged_otherwise(const fs::path& estimates_file, const fs::path& config,
+                                      const gtrack::Setup& setup, const gtrack::SetupOptions& so) {
+  std::error_code ec;
+  fs::path run_config = estimates_file.parent_path() / "run_config.toml";
+  if (!fs::is_regular_file(run_config, ec)) run_config = estimates_file.parent_path().parent_path() / "run_config.toml";
+  if (!fs::is_regular_file(run_config, ec) || fs::equivalent(run_config, config, ec)) return;
+  std::optional<gtrack::Projection> ran;
+  {
+    // What loading it says was said when it ran.
+    struct Quiet {
+      spdlog::level::level_enum level = gtrack::logger().level();
+      Quiet() { gtrack::logger().set_level(spdlog::level::off); }
+      ~Quiet() { gtrack::logger().set_level(level); }
+    } quiet;
+    try {
+      ran = gtrack::load_setup(run_config, so).sensor->projection();
+    } catch (const std::exception&) {
+      return;  // a run config this machine cannot load (its plugins elsewhere) is no evidence either way
+    }
+  }
+  const gtrack::Projection here = setup.sensor->projection();
+  if (!ran->world_to_image.isApprox(here.world_to_image, 1e-9) || ran->size.width != here.size.width ||
+      ran->size.height != here.size.height) {
+    gtrack::logger().warn("{}: its [sensor] images the world otherwise than {}'s (a sensor posed or sized "
+                          "otherwise): the errors are measured along {}'s axes, and the in-view shares from it",
+                          run_config.string(), config.string(), config.string());
+  }
+}
+
 int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   const fs::path truth_file = vm["truth"].as<std::string>();
   const fs::path estimates_file = vm["estimates"].as<std::string>();
@@ -182,30 +214,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   so.plugin_paths = common.plugin_paths;
   so.with_stimulus = false;
   gtrack::Setup setup = gtrack::load_setup(config, so);
-  // The run that wrote the estimates kept its config beside them: a sensor
-  // posed otherwise there splits the errors along other axes than the run's.
-  // (A two-pass table is in the run's folder's two_pass/ or backward/.)
-  fs::path run_config = estimates_file.parent_path() / "run_config.toml";
-  std::error_code same_ec;
-  if (!fs::is_regular_file(run_config, same_ec)) run_config = estimates_file.parent_path().parent_path() / "run_config.toml";
-  if (fs::is_regular_file(run_config, same_ec) && !fs::equivalent(run_config, config, same_ec)) {
-    const auto level = gtrack::logger().level();
-    try {
-      gtrack::logger().set_level(spdlog::level::off);  // what loading it says was said when it ran
-      const gtrack::Projection ran = gtrack::load_setup(run_config, so).sensor->projection();
-      gtrack::logger().set_level(level);
-      const gtrack::Projection here = setup.sensor->projection();
-      if (!ran.world_to_image.isApprox(here.world_to_image, 1e-9) || ran.size.width != here.size.width ||
-          ran.size.height != here.size.height) {
-        gtrack::logger().warn("{}: its [sensor] images the world otherwise than {}'s (a sensor posed or sized "
-                              "otherwise): the errors are measured along {}'s axes, and the in-view shares from it",
-                              run_config.string(), config.string(), config.string());
-      }
-    } catch (const std::exception&) {
-      // A run config this machine cannot load (its plugins elsewhere) is no evidence either way.
-      gtrack::logger().set_level(level);
-    }
-  }
+  warn_if_the_run_imaged_otherwise(estimates_file, config, setup, so);
   for (const auto& k : setup.root.keys()) setup.root.mark_used(k);  // engine tables are not used here
 
   gtrack::EvalOptions opt;

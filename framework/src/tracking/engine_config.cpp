@@ -127,7 +127,7 @@ std::string vec_text(const Eigen::Vector3d& v) {
   return buf;
 }
 
-SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radius) {
+SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, const SensorFrame& frame, double radius) {
   // Default box: the field of view around the nominal position, grown by the
   // model's radius so that a gripper half out of view is still reachable.
   const ImageSize size = sensor.image_size();
@@ -158,7 +158,6 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, double radi
   // about the nominal position: the default box is the same cube there. A
   // box given in the world bounds the search there by the box about its
   // corners, and the positions searched are kept within the world's box.
-  const SensorFrame frame = sensor_frame(sensor);
   if (!frame.is_world() && (t.has("position_min_mm") || t.has("position_max_mm"))) {
     s.world_box = ParameterSpace::PositionBox{frame.axes, frame.origin, s.position_min_mm, s.position_max_mm};
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -224,7 +223,9 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
     }
     const Eigen::VectorXd given = Eigen::Map<const Eigen::VectorXd>(pose.data(), model.dims());
     const Eigen::VectorXd h = frame.from_world(given);
-    if (!space.contains(h)) t.fail("initial_pose", "lies outside what the tracker searches: " + outside(space, frame, given, h));
+    if (!space.contains(h)) {
+      t.fail("initial_pose", "lies outside what the tracker searches: " + outside(space, frame, given, h));
+    }
     c.initial_pose = h;
   }
   c.fps = tracker_fps(t);
@@ -270,6 +271,8 @@ double tracker_fps(const ConfigTable& tracker) {
 EngineConfig engine_config(const Setup& setup) {
   const ConfigTable& root = setup.root;
   const ArticulatedModel& model = setup.model();
+  // The frame the search runs in: [search] and initial_pose are taken into it.
+  const SensorFrame frame = sensor_frame(*setup.sensor);
   EngineConfig e;
   {
     const ConfigTable t = root.table("observation");
@@ -293,7 +296,7 @@ EngineConfig engine_config(const Setup& setup) {
   }
   {
     const ConfigTable t = root.table("search");
-    e.search = read_search(t, *setup.sensor, model.radius_mm());
+    e.search = read_search(t, *setup.sensor, frame, model.radius_mm());
     t.check_all_used();
   }
   const auto& g = model.geometry();
@@ -304,7 +307,7 @@ EngineConfig engine_config(const Setup& setup) {
   e.space.position_box = e.search.world_box;
   {
     const ConfigTable t = root.table("tracker");
-    e.tracker = read_tracker(t, model, e.space, sensor_frame(*setup.sensor));
+    e.tracker = read_tracker(t, model, e.space, frame);
     t.check_all_used();
   }
   return e;

@@ -16,10 +16,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
-#include <opencv2/videoio/registry.hpp>
 #include <tiffio.h>
 
 #include "captured_stderr.hpp"
+#include "video_backend.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 
@@ -746,14 +746,12 @@ std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expec
   std::error_code ec;
   if (!fs::exists(spec, ec)) throw InputError(spec + ": no such file or folder");
   cv::VideoCapture cap;
-  // FFmpeg alone when it is there: the other backends print pages of
-  // warnings for an undecodable file, and the error below says it in a line.
-  const bool ffmpeg = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG);
+  // The error below says in a line what the decoder says.
   bool opened = false;
   std::string said;
   {
     detail::CapturedStderr library;  // released before the source seeks, which captures its own
-    opened = cap.open(spec, ffmpeg ? cv::CAP_FFMPEG : cv::CAP_ANY) && cap.isOpened();
+    opened = cap.open(spec, detail::video_backend()) && cap.isOpened();
     said = library.take();
   }
   if (!opened) {

@@ -10,7 +10,6 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <opencv2/videoio/registry.hpp>
 
 #include "gtrack/error.hpp"
 #include "gtrack/frame_source.hpp"
@@ -21,6 +20,7 @@
 #include "gtrack/tracker.hpp"
 #include "captured_stderr.hpp"
 #include "nearest_equivalent.hpp"
+#include "video_backend.hpp"
 #include "replace_file.hpp"
 #include "run_config.hpp"
 
@@ -85,11 +85,7 @@ void check_earlier_overlays(const fs::path& dir, const std::string& own) {
     bool readable = false;
     {
       detail::CapturedStderr decoder;  // "moov atom not found"
-      // FFmpeg, as the overlay was written and as inputs are read: any
-      // backend would also try the camera libraries on a damaged file.
-      cv::VideoCapture video;
-      video.open(it->path().string(),
-                 cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY);
+      cv::VideoCapture video(it->path().string(), detail::video_backend());
       cv::Mat first;
       readable = video.isOpened() && video.read(first) && !first.empty();
     }
