@@ -263,6 +263,39 @@ TEST(Synth, SequenceConfigCarriesFilesAndPluginFoldersAbsolute) {
   fs::remove_all(base);
 }
 
+// sequence.toml writes each float as the shortest text that reads back as
+// the same double (0.45, not TOML++'s 0.45000000000000001), and leaves
+// strings alone, even one that holds such a number.
+TEST(Synth, SequenceConfigWritesFloatsShortAndExact) {
+  const fs::path base = fs::temp_directory_path() / "gtrack_synth_floats";
+  fs::remove_all(base);
+  const fs::path odd_folder = base / "plugins 0.10000000000000001";
+  fs::create_directories(odd_folder);
+  gtrack::SetupOptions so;
+  so.plugin_paths = {odd_folder};
+  const fs::path config = fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_custom_gripper.toml";
+  const gtrack::Setup setup = gtrack::load_setup(config, so);
+  gtrack::SynthOptions o;
+  o.frames = 2;
+  gtrack::write_synthetic_sequence(setup, o, base / "seq");
+  std::ifstream t(base / "seq" / "sequence.toml");
+  const std::string text((std::istreambuf_iterator<char>(t)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("0000000000"), text.find("plugins 0.10000000000000001") + 11) << text;
+  EXPECT_EQ(text.find("0000000000", text.find("0000000000") + 10), std::string::npos) << text;
+  EXPECT_NE(text.find("[ 0.45, 0.0 ]"), std::string::npos) << text;
+  const auto original = gtrack::ConfigTable::parse(
+      [&] {
+        std::ifstream in(config);
+        return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      }(),
+      config.string());
+  const auto written = gtrack::ConfigTable::parse(text, "sequence.toml");
+  EXPECT_EQ(written.table("gripper").number_rows("palm_mm", 2), original.table("gripper").number_rows("palm_mm", 2));
+  EXPECT_EQ(written.table("gripper").tables("finger").at(0).numbers("link_lengths_mm"),
+            original.table("gripper").tables("finger").at(0).numbers("link_lengths_mm"));
+  fs::remove_all(base);
+}
+
 // The config's [synth] table sets the stimulus profile in the plugin's own
 // units; misspelt keys and an empty range are one-line errors that name the
 // file, the line and the key, raised before the output folder is touched.

@@ -7,8 +7,13 @@
 // is the sequence's, so that stimulus rates mean the same as when planned.
 // A configured initial pose is dropped: it described some other scene, and
 // the sequence must be tracked from the coarse search like a new recording.
+#include <cctype>
+#include <charconv>
 #include <filesystem>
 #include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 #include <toml++/toml.h>
 
@@ -33,6 +38,55 @@ void absolute_files(toml::table& table, const std::filesystem::path& base) {
       if (!p.empty() && p.is_relative()) *s = (base / p).lexically_normal().string();
     }
   }
+}
+
+// TOML++ as built prints a float with 17 significant digits (0.09 as
+// 0.089999999999999997). Each float outside a string is written again as
+// the shortest text that reads back as the same double.
+std::string shortest_floats(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  char quote = 0;
+  for (size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (quote) {
+      out += c;
+      if (c == '\\' && quote == '"' && i + 1 < text.size()) {
+        out += text[++i];
+      } else if (c == quote) {
+        quote = 0;
+      }
+      ++i;
+      continue;
+    }
+    if (c == '\'' || c == '"') quote = c;
+    const bool starts_value = i == 0 || std::string_view(" =[,\n").find(text[i - 1]) != std::string_view::npos;
+    if (starts_value && (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+')) {
+      size_t end = i + 1;
+      while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) ||
+                                   std::string_view(".+-_").find(text[end]) != std::string_view::npos))
+        ++end;
+      const std::string_view token = text.substr(i, end - i);
+      double value = 0;
+      const char* first = token.data() + (token.front() == '+');
+      const auto [ptr, ec] = std::from_chars(first, token.data() + token.size(), value);
+      char buf[32];
+      const auto written = std::to_chars(buf, buf + sizeof buf, value);
+      if (token.find_first_of(".eE") != std::string_view::npos && ec == std::errc() &&
+          ptr == token.data() + token.size() && written.ec == std::errc()) {
+        std::string shorter(buf, written.ptr);
+        if (shorter.find_first_of(".e") == std::string::npos) shorter += ".0";
+        out += shorter.size() < token.size() ? shorter : std::string(token);
+      } else {
+        out += token;
+      }
+      i = end;
+      continue;
+    }
+    out += c;
+    ++i;
+  }
+  return out;
 }
 
 }  // namespace
@@ -93,7 +147,10 @@ void write_sequence_config(const ConfigTable& config, const SynthPlan& plan, con
       << "# (preset '" << plan.preset.name << "', seed " << plan.options.seed << ", " << plan.frames.size()
       << " frames";
   if (plan.options.occlusion_scale != 1) out << ", occlusion scale " << plan.options.occlusion_scale;
-  out << "). Holds no ground truth: tracking starts from the coarse search.\n\n" << root << "\n";
+  out << "). Holds no ground truth: tracking starts from the coarse search.\n\n";
+  std::ostringstream body;
+  body << root << "\n";
+  out << shortest_floats(body.str());
   write_text_file(out_file, out.str());
 }
 
