@@ -17,6 +17,7 @@
 #include "gtrack/evaluation.hpp"
 #include "gtrack/text_file.hpp"
 #include "gtrack/log.hpp"
+#include "gtrack/sensor.hpp"
 #include "gtrack/setup.hpp"
 
 namespace po = boost::program_options;
@@ -28,6 +29,17 @@ void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) 
   std::cout << "  " << std::left << std::setw(22) << name << std::right << std::fixed << std::setprecision(2)
             << std::setw(9) << s.mean << " +- " << std::setw(7) << s.std << "  median " << std::setw(8) << s.median
             << "  max " << std::setw(8) << s.max << " " << unit << "\n";
+}
+
+// A sensor that images a slab (an ultrasound slice: two clip planes facing
+// each other across the viewing axis) has its "in-plane" error within the
+// imaging plane and its "depth" error across it, not below the probe.
+bool images_a_slab(const gtrack::Sensor& sensor) {
+  const gtrack::Projection p = sensor.projection();
+  if (p.clip_planes.size() != 2) return false;
+  const Eigen::Vector3d axis = gtrack::viewing_axis(p);
+  const Eigen::Vector3d a = p.clip_planes[0].head<3>().normalized(), b = p.clip_planes[1].head<3>().normalized();
+  return std::abs(std::abs(a.dot(axis)) - 1) < 1e-6 && a.dot(b) < -1 + 1e-6;
 }
 
 // What estimates.jsonl says of a frame: the occlusion allowance, and, from
@@ -302,8 +314,9 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     std::cout << "  no frame in view has an estimate: there are no error figures\n";
   } else {
     print_row("position 3D", ev.in_view.position_um, "um");
-    print_row("position in-plane", ev.in_view.position_inplane_um, "um");
-    print_row("depth", ev.in_view.depth_um, "um");
+    const bool slab = images_a_slab(*setup.sensor);
+    print_row(slab ? "in the imaging plane" : "position in-plane", ev.in_view.position_inplane_um, "um");
+    print_row(slab ? "across the plane" : "depth", ev.in_view.depth_um, "um");
     print_row("orientation", ev.in_view.orientation_deg, "deg");
     print_row("  about x", ev.in_view.axis_deg[0], "deg");
     print_row("  about y", ev.in_view.axis_deg[1], "deg");

@@ -499,6 +499,20 @@ TEST(Cli, AnEndlessConfigOrTableIsStopped) {
   EXPECT_NE(r.output.find("/dev/zero:1: a line of more than 65536 characters"), std::string::npos) << r.output;
 }
 
+// The truth's header and its rows whose line number `every` divides
+// (frames 1, 3, 5 ... for 2), as estimates (its pose
+// columns, without visible, in_view and occluded).
+std::string truth_as_estimates(const fs::path& truth, int every = 1) {
+  std::ifstream in(truth);
+  std::string text;
+  int line = 0;
+  for (std::string l; std::getline(in, l); ++line) {
+    for (int k = 0; k < 3; ++k) l = l.substr(0, l.rfind(','));
+    if (line % every == 0) text += l + "\n";
+  }
+  return text;
+}
+
 // A run with --frames and --every has no row for the frames it skipped:
 // eval counts them as lost and says which options judge only the others;
 // with them, only those frames are judged.
@@ -506,17 +520,9 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_every";
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 7 --seed 6 --out " + dir.string()).code, 0);
-  std::ifstream in(dir / "ground_truth.csv");
-  std::string text;
-  int line = 0;
-  for (std::string l; std::getline(in, l); ++line) {
-    // The truth's pose columns without visible, in_view, occluded: frames 1, 3, 5.
-    for (int k = 0; k < 3; ++k) l = l.substr(0, l.rfind(','));
-    if (line == 0 || line % 2 == 0) text += l + "\n";
-  }
   fs::create_directories(dir / "run");
   const fs::path estimates = dir / "run" / "estimates.csv";
-  std::ofstream(estimates) << text;
+  std::ofstream(estimates) << truth_as_estimates(dir / "ground_truth.csv", 2);  // frames 1, 3, 5
   const std::string eval = "eval -t " + (dir / "ground_truth.csv").string() + " -e " + estimates.string();
   CliRun r = gtrack(eval);
   EXPECT_EQ(r.code, 0) << r.output;
@@ -524,6 +530,8 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   EXPECT_NE(r.output.find("4 frames of"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(--frames 1: --every 2), evaluate with the same options"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("lost in all 4 (missing 4)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  position in-plane "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  depth "), std::string::npos) << r.output;
   r = gtrack(eval + " --frames 1: --every 2");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("frames 3: "), std::string::npos) << r.output;
@@ -825,6 +833,15 @@ TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("(preset ultrasound, seed 1)"), std::string::npos) << r.output;
   EXPECT_NE(read_file(dir / "a" / "sequence.toml").find("(preset 'ultrasound'"), std::string::npos);
+  // Its evaluation names the errors within the imaging plane and across
+  // it: an ultrasound image's depth is within the plane.
+  std::ofstream(dir / "a" / "estimates.csv") << truth_as_estimates(dir / "a" / "ground_truth.csv");
+  r = gtrack("eval -t " + (dir / "a" / "ground_truth.csv").string() + " -e " + (dir / "a" / "estimates.csv").string() +
+             " -c " + (dir / "a" / "sequence.toml").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("  in the imaging plane "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  across the plane "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("  depth "), std::string::npos) << r.output;
   // A camera config that segments by luminance gets grey frames too.
   const fs::path grey_camera =
       write("synth_preset_grey.toml", read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "tests" / "data" /
