@@ -206,6 +206,26 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& file) {
   return rows;
 }
 
+// A stimulus log in kelvin is refused at its first row, before a frame is
+// tracked, by the stimulus plugin's own range (followed or not).
+TEST(Cli, TrackRefusesAReadingTheStimulusPluginCannotTake) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "kelvin";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 3 --out " + dir.string()).code, 0);
+  std::ofstream(dir / "kelvin.csv") << "frame,value\n# logged in K\n0,295.15\n1,295.2\n";
+  for (const std::string follow : {"", " --follow-stimulus"}) {
+    const CliRun r =
+        gtrack(track_of(dir) + " -s " + (dir / "kelvin.csv").string() + follow + " -o " + (dir / "out").string());
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find((dir / "kelvin.csv").string() +
+                            ":3: a reading of 295.15, outside the -50 to 150 C temperature_hysteresis takes: "
+                            "expected degrees Celsius (a log in kelvin: subtract 273.15)"),
+              std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));
+  }
+}
+
 // --restart-from TABLE: each frame is tracked from the table's row for the
 // previous frame. A run that starts at frame 5 would begin with the coarse
 // search; from the ground truth it tracks frame 5 from frame 4's truth, and

@@ -3,6 +3,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "gtrack/error.hpp"
 #include "gtrack/stimulus_log.hpp"
@@ -55,6 +58,24 @@ TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
   EXPECT_EQ(error_of("time_s,value\n0.5\n"), "log.csv:2: expected two fields '<time_s>,<value>', got '0.5'");
   EXPECT_EQ(error_of("frame,value\n"), "log.csv: the stimulus log has a header but no rows");
   EXPECT_EQ(error_of(""), "log.csv: empty stimulus log; expected the header 'frame,value' or 'time_s,value'");
+}
+
+// A check of each reading (the tracker's: an instance of the stimulus
+// plugin) that throws is an error naming the file and the row's line.
+TEST(StimulusLog, AReadingTheCheckRefusesNamesItsLine) {
+  std::vector<double> seen;
+  const auto check = [&](double v) {
+    seen.push_back(v);
+    if (v > 150) throw std::invalid_argument("a reading of " + std::to_string(static_cast<int>(v)) + ", too hot");
+  };
+  EXPECT_NO_THROW(StimulusLog::parse("frame,value\n0,20\n# note\n1,21\n", "log.csv", check));
+  EXPECT_EQ(seen, (std::vector<double>{20, 21}));
+  try {
+    StimulusLog::parse("time_s,value\n0,20\n\n0.5,295.15\n", "log.csv", check);
+    ADD_FAILURE() << "a refused reading was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_STREQ(e.what(), "log.csv:4: a reading of 295, too hot");
+  }
 }
 
 TEST(StimulusLog, MissingFileIsAnInputError) {

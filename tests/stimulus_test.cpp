@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
 #include "support/plugins.hpp"
@@ -159,6 +160,24 @@ TEST(TemperatureHysteresis, TheResponseTimeKeepsTheFoldInsideAMovingRange) {
   EXPECT_DOUBLE_EQ(plain->penalty(std::vector<double>(2, 65.0)), 0.0);
   ramp(*plain, 38.0, 30.0, 50, 1.0, 0.1);
   EXPECT_DOUBLE_EQ(plain->penalty(std::vector<double>(2, 20.0)), 0.0);
+}
+
+// A reading no temperature of the plugin's range can be (a log in kelvin)
+// is refused, saying what was expected; one at the range's ends is taken.
+TEST(TemperatureHysteresis, RefusesAReadingThatIsNotCelsius) {
+  auto s = make_stimulus(kHydrogel);
+  EXPECT_NO_THROW(s->update(150, 0));
+  EXPECT_NO_THROW(s->update(-50, 1));
+  try {
+    s->update(296.15, 2);
+    ADD_FAILURE() << "a reading in kelvin was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected degrees Celsius (a log in kelvin: subtract 273.15)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(s->update(-60, 3), gtrack::InputError);
+  EXPECT_DOUBLE_EQ(s->state().value, -50);  // the refused readings changed nothing
 }
 
 TEST(TemperatureHysteresis, BadTablesAreRejected) {

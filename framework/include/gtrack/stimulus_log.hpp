@@ -7,9 +7,14 @@
 // "file:line: expected <what>, got '<text>'". A frame before the first or
 // after the last row is outside the log: value_at() returns nullopt and the
 // tracker warns once and holds the nearest reading.
+//
+// A ReadingCheck sees each row's reading as it is read and throws for one
+// it refuses (a stimulus plugin's update() given a temperature in kelvin);
+// the error is then "file:line: <its message>".
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <ios>
 #include <optional>
 #include <string>
@@ -23,13 +28,16 @@ class GTRACK_API StimulusLog {
  public:
   enum class Key { Frame, Time };
 
-  static StimulusLog load(const std::filesystem::path& file);
-  static StimulusLog parse(const std::string& text, const std::string& source = "<string>");
+  using ReadingCheck = std::function<void(double value)>;
+
+  static StimulusLog load(const std::filesystem::path& file, ReadingCheck check = {});
+  static StimulusLog parse(const std::string& text, const std::string& source = "<string>",
+                           ReadingCheck check = {});
   // A log still being written (a live run): poll() takes the rows appended
   // since the last call, whole lines only, with the same checks as parse()
   // (errors name the file and line); true when rows were added. The file may
   // be empty, or hold only its header, at first.
-  static StimulusLog follow(const std::filesystem::path& file);
+  static StimulusLog follow(const std::filesystem::path& file, ReadingCheck check = {});
   bool poll();
   // The last row's reading; nullopt while there is none.
   std::optional<double> latest() const;
@@ -52,6 +60,7 @@ class GTRACK_API StimulusLog {
   Key key_ = Key::Frame;
   std::vector<double> keys_, values_;
   std::string source_;
+  ReadingCheck check_;
   bool header_ = false;
   int lines_ = 0;                        // lines read so far (for error messages)
   std::filesystem::path followed_;       // follow(): the file

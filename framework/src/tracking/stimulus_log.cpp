@@ -37,7 +37,7 @@ constexpr size_t kMaxLine = 4096;
 
 }  // namespace
 
-StimulusLog StimulusLog::load(const std::filesystem::path& file) {
+StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck check) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
     throw InputError(file.string() + ": is a folder; expected a stimulus log (a CSV file)");
@@ -49,12 +49,13 @@ StimulusLog StimulusLog::load(const std::filesystem::path& file) {
     text += line;
     text += '\n';
   }
-  return parse(text, file.string());
+  return parse(text, file.string(), std::move(check));
 }
 
-StimulusLog StimulusLog::parse(const std::string& text, const std::string& source) {
+StimulusLog StimulusLog::parse(const std::string& text, const std::string& source, ReadingCheck check) {
   StimulusLog log;
   log.source_ = source;
+  log.check_ = std::move(check);
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line)) log.take_line(std::move(line));
@@ -102,13 +103,21 @@ void StimulusLog::take_line(std::string line) {
   if (!keys_.empty() && !(k > keys_.back())) {
     throw InputError(where + "expected " + key_name + " greater than the previous row's, got " + quoted(a));
   }
+  if (check_) {
+    try {
+      check_(v);
+    } catch (const std::exception& e) {
+      throw InputError(where + e.what());
+    }
+  }
   keys_.push_back(k);
   values_.push_back(v);
 }
 
-StimulusLog StimulusLog::follow(const std::filesystem::path& file) {
+StimulusLog StimulusLog::follow(const std::filesystem::path& file, ReadingCheck check) {
   StimulusLog log;
   log.source_ = file.string();
+  log.check_ = std::move(check);
   log.followed_ = file;
   std::ifstream probe(file, std::ios::binary);
   if (!probe) throw InputError(file.string() + ": cannot open the stimulus log");

@@ -216,7 +216,17 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   }
   int restarts_used = 0, references_used = 0;
   if (options.stimulus_csv) {
-    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv) : StimulusLog::load(*options.stimulus_csv);
+    // Each row is fed to an instance of the stimulus plugin of its own as it
+    // is read, so that a reading the plugin refuses (a temperature in
+    // kelvin) is an error naming its line, before a frame is tracked.
+    StimulusLog::ReadingCheck check;
+    if (setup.loader) {
+      check = [probe = setup.loader->make_stimulus(setup.root.table("stimulus")), row = 0](double value) mutable {
+        probe->update(value, row++);
+      };
+    }
+    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
+                                  : StimulusLog::load(*options.stimulus_csv, std::move(check));
   }
   // Resuming: the saved state says which frame was done last; the source
   // starts at the next frame of the range.

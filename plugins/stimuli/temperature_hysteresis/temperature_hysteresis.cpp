@@ -24,23 +24,31 @@
 // feasible within `tolerance_deg` of that interval, which replaces settle_s:
 // during a fold the allowed range moves with the fold instead of spanning
 // every value between the references.
+// A reading outside -50 to 150 C, the range its thresholds may take, is not
+// a temperature in Celsius (a log in kelvin or of another quantity): update()
+// refuses it rather than fold the model by it.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <gtrack/error.hpp>
 #include <gtrack/plugin.hpp>
+#include <string>
 
 namespace {
 
 // The folding range is entered slightly before its nominal edges.
 constexpr double kBandMarginC = 0.5;
+// The temperatures the plugin takes, in its thresholds and its readings.
+constexpr double kLowestC = -50, kHighestC = 150;
 
 class TemperatureHysteresis final : public gtrack::Stimulus {
  public:
   explicit TemperatureHysteresis(const gtrack::ConfigTable& t) {
     using gtrack::Range;
     mode_ = t.choice_or("mode", "reversible", {"reversible", "latching"});
-    unfold_below_ = t.number_or("unfold_below_C", 24.0, Range::closed(-50, 150));
-    fold_above_ = t.number_or("fold_above_C", 27.0, Range::closed(-50, 150));
-    trigger_ = t.number_or("trigger_C", 37.0, Range::closed(-50, 150));
+    unfold_below_ = t.number_or("unfold_below_C", 24.0, Range::closed(kLowestC, kHighestC));
+    fold_above_ = t.number_or("fold_above_C", 27.0, Range::closed(kLowestC, kHighestC));
+    trigger_ = t.number_or("trigger_C", 37.0, Range::closed(kLowestC, kHighestC));
     unfolded_ = t.number_or("unfolded_deg", 0.0, Range::closed(-180, 180));
     folded_ = t.number_or("folded_deg", 60.0, Range::closed(-180, 180));
     tolerance_ = t.number_or("tolerance_deg", 10.0, Range::non_negative());
@@ -58,6 +66,13 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
   }
 
   void update(double value, double time_s) override {
+    if (std::isfinite(value) && (value < kLowestC || value > kHighestC)) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "a reading of %g, outside the %g to %g C temperature_hysteresis takes: expected degrees Celsius%s",
+                    value, kLowestC, kHighestC, value > 200 && value < 500 ? " (a log in kelvin: subtract 273.15)" : "");
+      throw gtrack::InputError(text);
+    }
     if (std::isfinite(value)) {
       if (has_prev_ && time_s > prev_time_) {
         const double raw = (value - state_.value) / (time_s - prev_time_);
