@@ -207,7 +207,8 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& file) {
 }
 
 // A stimulus log in kelvin is refused at its first row, before a frame is
-// tracked, by the stimulus plugin's own range (followed or not).
+// tracked, by the stimulus plugin's own range (followed or not); one keyed
+// by another clock at the first frame.
 TEST(Cli, TrackRefusesAReadingTheStimulusPluginCannotTake) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "kelvin";
   fs::remove_all(dir);
@@ -224,6 +225,14 @@ TEST(Cli, TrackRefusesAReadingTheStimulusPluginCannotTake) {
         << r.output;
     EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));
   }
+  // A log keyed by Unix time has no row near the recording's frames.
+  std::ofstream(dir / "unix.csv") << "time_s,value\n1765011000.0,22\n1765011000.5,22.5\n";
+  const CliRun r = gtrack(track_of(dir) + " -s " + (dir / "unix.csv").string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("unix.csv: its times start at t = 1765011000.000 s, more than a day after frame 0 (t = "
+                          "0.000 s); expected seconds from the recording's first frame"),
+            std::string::npos)
+      << r.output;
 }
 
 // --restart-from TABLE: each frame is tracked from the table's row for the

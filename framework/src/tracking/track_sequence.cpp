@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <fmt/format.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -293,15 +294,19 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     std::optional<double> reading = log->value_at(index, time_s);
     if (!reading) {
+      const bool by_time = log->key() == StimulusLog::Key::Time;
+      if (by_time && log->first_key() > time_s + 86400) {
+        // Another clock: seconds since 1970 (Unix time), say.
+        throw InputError(fmt::format(
+            "{}: its times start at t = {:.3f} s, more than a day after frame {} (t = {:.3f} s); expected seconds "
+            "from the recording's first frame (a log in Unix time needs its first frame's time subtracted)",
+            log->source(), log->first_key(), index, time_s));
+      }
       if (!warned_range) {
-        // The log's span is said: a log keyed by another clock (seconds
-        // since 1970, say) shows at once.
-        const bool by_time = log->key() == StimulusLog::Key::Time;
-        logger().warn(
-            "{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.9g} to {:.9g}; "
-            "holding its nearest reading",
-            log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(),
-            log->last_key());
+        logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.{}f} to {:.{}f}; "
+                      "holding its nearest reading",
+                      log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(), by_time ? 3 : 0,
+                      log->last_key(), by_time ? 3 : 0);
         warned_range = true;
       }
       reading = log->nearest(index, time_s);
