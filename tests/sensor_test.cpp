@@ -141,6 +141,12 @@ TEST(PinholeMicroscope, ReadsOpenCvCalibrationFiles) {
     out << "cameraResolution" << cv::Size(640, 480) << "cameraMatrix" << K << "dist_coeffs" << D.colRange(0, 5);
   }
   expect_same_camera(keys, make_sensor("plugin = \"pinhole_microscope\"\ncalibration = \"" + interactive.string() + "\""));
+  // JSON with the matrix as rows.
+  const fs::path rows = calibration_dir() / "rows.json";
+  std::ofstream(rows) << R"({"image_width": 640, "image_height": 480,
+    "camera_matrix": [[6400, 0, 321.5], [0, 6420, 238.25], [0, 0, 1]],
+    "distortion_coefficients": [[-0.3, 0.12, 0.001, -0.002, 0.05]]})";
+  expect_same_camera(keys, make_sensor("plugin = \"pinhole_microscope\"\ncalibration = \"" + rows.string() + "\""));
 }
 
 TEST(PinholeMicroscope, ReadsRosCameraInfoWithAPathFromTheConfigsFolder) {
@@ -210,6 +216,16 @@ TEST(PinholeMicroscope, BadCalibrationFilesAreOneLineNamingFileAndKey) {
   expect_error(write("tilt.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"
                                  "distortion_coefficients: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.01, 0]\n"),
                "has 13 coefficients with thin-prism or tilt terms");
+  // A distortion under a name that is not read would leave the lens
+  // uncorrected without a word.
+  expect_error(write("dist_coeff.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"
+                                       "dist_coeff: [0.1, 0, 0, 0]\n"),
+               "dist_coeff.yml: 'dist_coeff' is not read; expected the distortion as 'distortion_coefficients'");
+  expect_error(write("dist_twice.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"
+                                       "distortion_coefficients: [0.1, 0, 0, 0]\nDistortion: [0.2, 0, 0, 0]\n"),
+               "'Distortion' is not read ('distortion_coefficients' is)");
+  expect_error(write("ragged.json", R"({"camera_matrix": [[6400, 0, 320], 0, [0, 0, 1]]})"),
+               "'camera_matrix' is not a list or matrix of numbers");
   // A ROS file that opens its document with "---": its own lines are named.
   expect_error(write("dashes.yaml", "---\nimage_width: 640\ncamera_matrix: [1, 2\n"), "dashes.yaml:3: ");
   expect_error(write("nosize.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"),

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -32,17 +33,27 @@ struct Calibration {
   int width = 0, height = 0;       // 0: the file does not say
 };
 
-// The numbers of a node: a sequence, a single number, or a matrix (a map
-// whose "data" is the sequence: !!opencv-matrix and ROS alike).
+// The numbers of a node: a sequence, a single number, a matrix (a map
+// whose "data" is the sequence: !!opencv-matrix and ROS alike), or a
+// sequence of rows ([[fx, 0, cx], [0, fy, cy], [0, 0, 1]]), row by row.
 std::optional<std::vector<double>> numbers_of(const cv::FileNode& node) {
   const cv::FileNode data = node.isMap() ? node["data"] : node;
   std::vector<double> out;
   if (data.isInt() || data.isReal()) {
     out.push_back(static_cast<double>(data));
   } else if (data.isSeq()) {
+    const bool rows = data.size() > 0 && data[0].isSeq();
     for (const cv::FileNode& v : data) {
-      if (!v.isInt() && !v.isReal()) return std::nullopt;
-      out.push_back(static_cast<double>(v));
+      if (rows && v.isSeq()) {
+        for (const cv::FileNode& x : v) {
+          if (!x.isInt() && !x.isReal()) return std::nullopt;
+          out.push_back(static_cast<double>(x));
+        }
+      } else if (!rows && (v.isInt() || v.isReal())) {
+        out.push_back(static_cast<double>(v));
+      } else {
+        return std::nullopt;
+      }
     }
   } else {
     return std::nullopt;
@@ -143,6 +154,18 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     }
   }
   const auto dist = first_of({"distortion_coefficients", "dist_coeffs", "distCoeffs", "D"});
+  // Another entry that names a distortion would be dropped without a word,
+  // leaving the lens uncorrected.
+  for (const std::string& entry : in.root().keys()) {
+    std::string lower = entry;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
+    if (entry != dist.first && lower.find("dist") != std::string::npos && lower != "distortion_model") {
+      t.fail(key, name + ": '" + entry + "' is not read" +
+                      (dist.first.empty() ? "" : " ('" + dist.first + "' is)") +
+                      "; expected the distortion as 'distortion_coefficients' (OpenCV, ROS), 'dist_coeffs', "
+                      "'distCoeffs' or 'D', once");
+    }
+  }
   if (!dist.first.empty()) {
     std::vector<double> d = numbers(dist);
     for (const double x : d) {
