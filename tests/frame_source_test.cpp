@@ -262,7 +262,8 @@ std::string logged(F&& f) {
 
 // Frames are numbered by their order in a folder: a number missing from
 // the names (a dropped frame) is warned about, once, with the first gap;
-// names that carry time stamps, which never count up by one, are not.
+// names that carry time stamps, which never count up by one, are not. The
+// number that counts is the one that changes between names.
 TEST(FrameSource, AGapInAFoldersNumberingIsWarnedAbout) {
   const fs::path gap = folder_of("gap", {"img_0001.png", "img_0002.png", "img_0003.png", "img_0005.png",
                                          "img_0006.png", "img_0009.png"});
@@ -278,6 +279,17 @@ TEST(FrameSource, AGapInAFoldersNumberingIsWarnedAbout) {
   const fs::path stamped = folder_of("stamped", {"cam_1701234567123.png", "cam_1701234567156.png",
                                                  "cam_1701234567190.png"});
   warned = logged([&] { gtrack::open_frame_source(stamped.string(), {4, 4}, {}, 30); });
+  EXPECT_EQ(warned, "");
+  // Micro-Manager's names count in their first number, not their last.
+  const fs::path mm = folder_of("micromanager", {"img_000000010_Default_000.png", "img_000000011_Default_000.png",
+                                                 "img_000000013_Default_000.png", "img_000000014_Default_000.png"});
+  warned = logged([&] { gtrack::open_frame_source(mm.string(), {4, 4}, {}, 30); });
+  EXPECT_NE(warned.find("skip from img_000000011_Default_000.png to img_000000013_Default_000.png;"),
+            std::string::npos)
+      << warned;
+  // A clock in the name changes in more than one number across a minute.
+  const fs::path clock = folder_of("clock", {"t10-58.png", "t10-59.png", "t11-00.png", "t11-01.png"});
+  warned = logged([&] { gtrack::open_frame_source(clock.string(), {4, 4}, {}, 30); });
   EXPECT_EQ(warned, "");
   const fs::path whole = folder_of("whole", {"f0.png", "f1.png", "f2.png"});
   warned = logged([&] { gtrack::open_frame_source(whole.string(), {4, 4}, {}, 30); });

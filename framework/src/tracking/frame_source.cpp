@@ -294,27 +294,50 @@ bool natural_less(const std::string& a, const std::string& b) {
   return a < b;
 }
 
-// The last run of digits in a file name and the text around it:
-// "img_0041.png" is {"img_", 41, ".png"}; a name without digits has none.
-struct NameNumber {
-  std::string before, after;
-  long long value = -1;
+// A file name as its runs of digits (numbers; a run of more than 15 digits
+// is text) and the text between them: "img_0041_Default_000.png" is
+// {"img_", 41, "_Default_", 0, ".png"}.
+struct NameRuns {
+  std::vector<std::string> text;   // the text before each number, and after the last
+  std::vector<long long> numbers;
 };
-NameNumber name_number(const std::string& name) {
-  const size_t end = name.find_last_of("0123456789");
-  if (end == std::string::npos) return {};
-  size_t start = end;
-  while (start > 0 && name[start - 1] >= '0' && name[start - 1] <= '9') --start;
-  if (end + 1 - start > 15) return {};  // not a frame number
-  return {name.substr(0, start), name.substr(end + 1), std::stoll(name.substr(start, end + 1 - start))};
+
+NameRuns name_runs(const std::string& name) {
+  NameRuns r;
+  std::string text;
+  for (size_t i = 0; i < name.size();) {
+    size_t j = i;
+    while (j < name.size() && name[j] >= '0' && name[j] <= '9') ++j;
+    if (j > i && j - i <= 15) {
+      r.text.push_back(text);
+      r.numbers.push_back(std::stoll(name.substr(i, j - i)));
+      text.clear();
+      i = j;
+    } else {
+      text += name.substr(i, std::max<size_t>(j - i, 1));
+      i = std::max(j, i + 1);
+    }
+  }
+  r.text.push_back(text);
+  return r;
 }
 
 // How image `b`'s number follows image `a`'s: 1 the next number, 0 a gap,
-// -1 no numbering to check (names that differ otherwise, or carry no number).
+// -1 no numbering to check (names that differ in their text or in more
+// than one number, such as time stamps, or carry no number). The number
+// that counts is the one that changes: Micro-Manager's
+// "img_000000011_Default_000.png" counts in its first.
 int numbered_next(const fs::path& a, const fs::path& b) {
-  const NameNumber x = name_number(a.filename().string()), y = name_number(b.filename().string());
-  if (x.value < 0 || y.value < 0 || x.before != y.before || x.after != y.after) return -1;
-  return y.value == x.value + 1 ? 1 : 0;
+  const NameRuns x = name_runs(a.filename().string()), y = name_runs(b.filename().string());
+  if (x.text != y.text) return -1;
+  int changed = -1;
+  for (size_t k = 0; k < x.numbers.size(); ++k) {
+    if (x.numbers[k] == y.numbers[k]) continue;
+    if (changed >= 0) return -1;
+    changed = static_cast<int>(k);
+  }
+  if (changed < 0) return -1;
+  return y.numbers[static_cast<size_t>(changed)] == x.numbers[static_cast<size_t>(changed)] + 1 ? 1 : 0;
 }
 
 class FolderSource final : public FrameSource {
