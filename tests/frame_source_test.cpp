@@ -380,6 +380,7 @@ TEST(FrameSource, AFrameDroppedFromAVideoKeepsTheNumbersAfterIt) {
 // A 12-bit camera stores its values in the low bits of 16-bit files: at
 // the default 16 bits they come out dark, which is warned about once; with
 // image_bits = 12 they fill the 8 bits, in the first pass and when read again.
+// Values above what image_bits says (the high bits) are warned about.
 TEST(FrameSource, SixteenBitImagesAreScaledByTheirSignificantBits) {
   const fs::path dir = folder_of("twelve_bits", {});
   const std::vector<int> values = {4095, 2048, 600};
@@ -411,6 +412,18 @@ TEST(FrameSource, SixteenBitImagesAreScaledByTheirSignificantBits) {
   EXPECT_EQ(recording.read(1, 2).at(1).at<cv::Vec3b>(3, 3), cv::Vec3b::all(128));
   auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
   EXPECT_THROW(src->set_image_bits(17), std::invalid_argument);
+  // 12 bits in the high bits of each sample, said to be 12: they saturate.
+  const fs::path high = folder_of("twelve_high_bits", {});
+  ASSERT_TRUE(cv::imwrite((high / "f0.png").string(), cv::Mat(8, 8, CV_16UC1, cv::Scalar(4095 << 4))));
+  const std::string saturated = logged([&] {
+    auto s = gtrack::open_frame_source(high.string(), {8, 8}, {}, 25);
+    s->set_image_bits(12);
+    s->next();
+  });
+  EXPECT_NE(saturated.find("f0.png: a 16-bit image with values up to 65520, above the 4095 of [tracker] image_bits = "
+                           "12, which saturate"),
+            std::string::npos)
+      << saturated;
 }
 
 namespace {

@@ -63,6 +63,13 @@ cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
         logger().warn("{}: a 16-bit image whose values reach only {} of {:.0f}, so it is dark at 8 bits; if the "
                       "camera gives fewer bits, say so with [tracker] image_bits (now {})",
                       name, max, top, image_bits_);
+      } else if (max > top) {
+        // Fewer bits said than the files hold: a camera that puts its 12
+        // bits in the high bits of each sample needs no image_bits at all.
+        logger().warn("{}: a 16-bit image with values up to {}, above the {:.0f} of [tracker] image_bits = {}, "
+                      "which saturate; image_bits is for data in the low bits (data in the high bits needs the "
+                      "default, 16)",
+                      name, max, top, image_bits_);
       }
     }
     out.convertTo(out, CV_8U, 255.0 / top);
