@@ -260,9 +260,11 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
 }
 
 // Grey images for a segmentation by colour: every frame would be lost
-// without a word, so the first frame says why, once.
-TEST(Fault, GreyFramesForAColourSegmentationAreSaidOnce) {
-  const TrackRun r = make_run();
+// without a word, so the first frame says why, once; a blank frame (one
+// value throughout: the lamp off) says nothing of the recording. Bounds that
+// find nothing, or take most of the image, are said too.
+TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
+  TrackRun r = make_run();
   const auto warnings_of = [&](const fs::path& frames, const fs::path& out) {
     std::ostringstream log;
     gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
@@ -302,6 +304,35 @@ TEST(Fault, GreyFramesForAColourSegmentationAreSaidOnce) {
   const std::string mixed_log = warnings_of(colour, dir / "out_mixed");
   EXPECT_NE(mixed_log.find("000001.png: " + said), std::string::npos) << mixed_log;
   EXPECT_EQ(mixed_log.find(said), mixed_log.rfind(said)) << "said once: " << mixed_log;
+  // A black first frame before grey ones: said at the first grey one.
+  cv::imwrite((dir / "grey" / "000000.png").string(), cv::Mat(kSide, kSide, CV_8UC1, cv::Scalar(0)));
+  const std::string blank_log = warnings_of(dir / "grey", dir / "out_blank");
+  EXPECT_EQ(blank_log.find("000000.png: " + said), std::string::npos) << blank_log;
+  EXPECT_NE(blank_log.find("000001.png: " + said), std::string::npos) << blank_log;
+  EXPECT_EQ(blank_log.find("no pixel within"), std::string::npos) << blank_log;
+  // Colour frames whose colour the bounds exclude: every frame is lost.
+  const fs::path plain = write_frames(dir / "plain", 3);
+  r.config.observation.hue_min = 100;  // blue; the gripper is green
+  r.config.observation.hue_max = 130;
+  const std::string empty_log = warnings_of(plain, dir / "out_empty");
+  const std::string nothing = "000000.png: no pixel within the [observation] bounds (hue 100 to 130, saturation 60 "
+                              "to 255, value 0 to 255): the frame is lost";
+  EXPECT_NE(empty_log.find(nothing), std::string::npos) << empty_log;
+  EXPECT_EQ(empty_log.find("no pixel"), empty_log.rfind("no pixel")) << "said once: " << empty_log;
+  // A dark gripper on a light background, segmented for bright pixels.
+  r.config.observation.color_space = "luminance";
+  fs::create_directories(dir / "bright_field");
+  for (int i = 0; i < 2; ++i) {
+    cv::Mat inverted = cv::Scalar::all(255) - frame_image(i);
+    cv::imwrite((dir / "bright_field" / ("00000" + std::to_string(i) + ".png")).string(), inverted);
+  }
+  const std::string bright_log = warnings_of(dir / "bright_field", dir / "out_bright");
+  EXPECT_NE(bright_log.find("% of the image is within the [observation] bounds (luminance 128 to 255): they take "
+                            "the background for the gripper"),
+            std::string::npos)
+      << bright_log;
+  EXPECT_NE(bright_log.find("needs luminance_min = 0"), std::string::npos) << bright_log;
+  EXPECT_EQ(warnings_of(plain, dir / "out_dark_field").find("of the image is within"), std::string::npos);
 }
 
 // A folder whose image becomes unreadable part way: the run stops at that

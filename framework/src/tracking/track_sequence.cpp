@@ -159,24 +159,77 @@ PoseTable read_gripper_poses(const fs::path& file, const Setup& setup, bool trut
   return table;
 }
 
-// A grey image (its three channels equal: a grayscale or 16-bit grey file
-// read as colour) has no saturation, so a colour segmentation that needs
-// some finds nothing in it: said once, at the first frame or at the first
-// frame that finds nothing (a grey image among colour ones), instead of
-// frames coming out lost without a word. True when said.
-bool warn_if_grey_for_colour(const Frame& frame, const ObservationConfig& o, bool first) {
-  if (o.color_space != "hsv" || !(o.saturation_min > 0) || frame.image.channels() != 3) return false;
-  cv::Mat channels[3];
-  cv::split(frame.image, channels);
-  if (cv::countNonZero(channels[0] != channels[1]) > 0 || cv::countNonZero(channels[1] != channels[2]) > 0) {
-    return false;
+// What the [observation] bounds make of the recording, said once each
+// instead of frames coming out lost, or tracked on the background, without
+// a word:
+// - a grey image (its three channels equal: a grayscale or 16-bit grey file
+//   read as colour) has no saturation, so a colour segmentation that needs
+//   some finds nothing in it: said at the first frame, or at the first
+//   frame that finds nothing (a grey image among colour ones); a frame of
+//   one value throughout (the lamp off, a blank frame) says nothing of the
+//   recording and is passed over;
+// - the first frame that observes nothing, while none before it did;
+// - a first frame whose observation covers most of the image: the bounds
+//   take the background for the gripper (a bright-field recording, a dark
+//   gripper on a light background, segmented for bright pixels).
+class ObservationAdvice {
+ public:
+  explicit ObservationAdvice(const ObservationConfig& o) : o_(o) {}
+
+  void after(const Frame& frame, const Estimate& e, const Observation& observation, bool first) {
+    if (!said_grey_ && (first || e.observed_pixels == 0)) said_grey_ = grey_for_colour(frame, first);
+    if (!said_empty_ && !seen_any_ && e.observed_pixels == 0 && !said_grey_ && !uniform(frame.image)) {
+      said_empty_ = true;
+      logger().warn("{}: no pixel within the [observation] bounds ({}): the frame is lost, as every frame will be "
+                    "until the gripper shows; if it is in view, check the bounds on this recording with --save-masks",
+                    frame.name, bounds());
+    }
+    seen_any_ = seen_any_ || e.observed_pixels > 0;
+    const double share = observation.mask.empty() ? 0.0 : double(e.observed_pixels) / observation.mask.total();
+    if (first && share > 0.5) {
+      logger().warn("{}: {:.0f} % of the image is within the [observation] bounds ({}): they take the background "
+                    "for the gripper, and the track follows it; {} (check with --save-masks)",
+                    frame.name, 100 * share, bounds(),
+                    o_.color_space == "luminance"
+                        ? "a dark gripper on a light background needs luminance_min = 0 and luminance_max below "
+                          "the background's"
+                        : "narrow them to the gripper's colour");
+    }
   }
-  logger().warn("{}: a grey image, but [observation] color_space = \"hsv\" with saturation_min = {} finds "
-                "nothing without colour; {} (for grey images use color_space = \"luminance\")",
-                frame.name, o.saturation_min,
-                first ? "every frame will be lost" : "it is lost, and every grey image after it");
-  return true;
-}
+
+ private:
+  static bool uniform(const cv::Mat& image) {
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(image.reshape(1), &lo, &hi);
+    return lo == hi;
+  }
+
+  std::string bounds() const {
+    if (o_.color_space == "luminance") {
+      return fmt::format("luminance {:g} to {:g}", o_.luminance_min, o_.luminance_max);
+    }
+    return fmt::format("hue {:g} to {:g}, saturation {:g} to {:g}, value {:g} to {:g}", o_.hue_min, o_.hue_max,
+                       o_.saturation_min, o_.saturation_max, o_.value_min, o_.value_max);
+  }
+
+  bool grey_for_colour(const Frame& frame, bool first) const {
+    if (o_.color_space != "hsv" || !(o_.saturation_min > 0) || frame.image.channels() != 3) return false;
+    if (uniform(frame.image)) return false;
+    cv::Mat channels[3];
+    cv::split(frame.image, channels);
+    if (cv::countNonZero(channels[0] != channels[1]) > 0 || cv::countNonZero(channels[1] != channels[2]) > 0) {
+      return false;
+    }
+    logger().warn("{}: a grey image, but [observation] color_space = \"hsv\" with saturation_min = {} finds "
+                  "nothing without colour; {} (for grey images use color_space = \"luminance\")",
+                  frame.name, o_.saturation_min,
+                  first ? "every frame will be lost" : "it is lost, and every grey image after it");
+    return true;
+  }
+
+  const ObservationConfig& o_;
+  bool said_grey_ = false, said_empty_ = false, seen_any_ = false;
+};
 
 }  // namespace
 
@@ -380,7 +433,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   double cost_sum = 0, ms_sum = 0;
   StageTimes sums;
   int previous_index = -1;  // the last frame tracked by this run
-  bool warned_grey = false;
+  ObservationAdvice advice(config.observation);
   for (;;) {
     if (options.cancel && options.cancel->load()) {
       summary.cancelled = true;
@@ -406,9 +459,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       }
     }
     Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
-    if (!warned_grey && (summary.frames == 0 || e.observed_pixels == 0)) {
-      warned_grey = warn_if_grey_for_colour(*frame, config.observation, summary.frames == 0);
-    }
+    advice.after(*frame, e, tracker.last_observation(), summary.frames == 0);
     previous_index = frame->index;
     if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
       // Of the reference's symmetric equivalents, the one nearest the estimate.
