@@ -294,13 +294,14 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     for (std::size_t i = 1; i < estimates.rows.size(); ++i) {
       stride = std::gcd(stride, std::abs(estimates.rows[i].frame - estimates.rows[i - 1].frame));
     }
-    const int first = estimates.rows.front().frame;
-    if (stride > 1 || first > truth.rows.front().frame) {
-      std::string options = "--frames " + std::to_string(first) + ":";
+    const int first = estimates.rows.front().frame, last = estimates.rows.back().frame;
+    const bool ends_early = last + std::max(stride, 1) <= truth.rows.back().frame;
+    if (stride > 1 || first > truth.rows.front().frame || ends_early) {
+      std::string options = "--frames " + std::to_string(first) + ":" + (ends_early ? std::to_string(last + 1) : "");
       if (stride > 1) options += " --every " + std::to_string(stride);
-      gtrack::logger().warn("{} frames of {} have no estimate and count as lost; the estimates start at frame {}{}: "
-                            "for a run that tracked only those ({}), evaluate with the same options",
-                            ev.missing_frames, truth_file.string(), first,
+      gtrack::logger().warn("{} frames of {} have no estimate and count as lost; the estimates are of frames {} to "
+                            "{}{}: for a run that tracked only those ({}), evaluate with the same options",
+                            ev.missing_frames, truth_file.string(), first, last,
                             stride > 1 ? " and hold one frame in " + std::to_string(stride) : std::string(), options);
     }
   }

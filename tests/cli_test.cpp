@@ -558,6 +558,8 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   EXPECT_EQ(r.output.find("images the world otherwise"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("4 frames of"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(--frames 1: --every 2), evaluate with the same options"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the estimates are of frames 1 to 5 and hold one frame in 2"), std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("lost in all 4 (missing 4)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("  position in-plane "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("  depth "), std::string::npos) << r.output;
@@ -566,6 +568,16 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   EXPECT_NE(r.output.find("frames 3: "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("lost in all 0 (missing 0)"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("have no estimate"), std::string::npos) << r.output;
+  // A run that stopped early (--frames 1:4): the end is said too.
+  const fs::path early = dir / "early.csv";
+  std::string rows = truth_as_estimates(dir / "ground_truth.csv", 2);  // frames 1, 3, 5
+  rows.erase(rows.rfind('\n', rows.size() - 2) + 1);                  // without frame 5
+  std::ofstream(early) << rows;
+  r = gtrack("eval -t " + (dir / "ground_truth.csv").string() + " -e " + early.string());
+  EXPECT_NE(r.output.find("the estimates are of frames 1 to 3 and hold one frame in 2: for a run that tracked only "
+                          "those (--frames 1:4 --every 2)"),
+            std::string::npos)
+      << r.output;
   r = gtrack(eval + " --frames 7:");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--frames/--every select none of the frames of"), std::string::npos) << r.output;
