@@ -4,6 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "gtrack/error.hpp"
 #include "gtrack/observation.hpp"
 
 namespace {
@@ -81,6 +82,24 @@ TEST(Observation, RoiAndPriorDropFarPixels) {
 TEST(Observation, NothingDetectedIsEmpty) {
   gtrack::Segmenter seg(gtrack::ObservationConfig{}, {200, 200}, {50, 50});
   EXPECT_TRUE(seg.observe(grey_frame()).empty());
+}
+
+// A frame of the right size but not 8-bit BGR is refused, naming what it is.
+TEST(Observation, AFrameOfOtherChannelsIsRefusedNamingThem) {
+  gtrack::Segmenter seg(gtrack::ObservationConfig{}, {200, 200}, {50, 50});
+  const auto error_of = [&](const cv::Mat& frame) -> std::string {
+    try {
+      seg.observe(frame);
+    } catch (const gtrack::InputError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(error_of(cv::Mat(200, 200, CV_8UC1, cv::Scalar(0))).find("got 200x200 with 1 channel of 8 bits"),
+            std::string::npos);
+  EXPECT_NE(error_of(cv::Mat(200, 200, CV_16UC4, cv::Scalar::all(0))).find("got 200x200 with 4 channels of 16 bits"),
+            std::string::npos);
+  EXPECT_NE(error_of(cv::Mat(100, 200, CV_8UC3)).find("expected a 200x200 BGR image"), std::string::npos);
 }
 
 }  // namespace
