@@ -31,6 +31,9 @@ struct Frame {
   double time_s = 0;  // index / fps
   cv::Mat image;      // BGR, CV_8UC3
   std::string name;   // file name or "frame N", for messages
+  // Following a folder: the time spent waiting for the image to arrive and
+  // to be written whole, which is the camera's, not reading.
+  double waited_s = 0;
 };
 
 // A half-open range [first, last) of frame indices; last < 0 = to the end.

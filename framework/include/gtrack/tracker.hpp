@@ -60,7 +60,10 @@ GTRACK_API const char* to_string(TrackStatus status);
 struct StageTimes {
   double segment_ms = 0;
   double pso_ms = 0;
-  double io_ms = 0;  // reading the frame, writing results and overlay
+  // In an estimate: reading the frame (a followed folder's wait for it left
+  // out); the row is written before its overlay, so that a controller gets
+  // it first. In a run's mean: reading, and writing results and overlay.
+  double io_ms = 0;
 };
 
 struct Estimate {

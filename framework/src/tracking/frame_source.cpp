@@ -358,6 +358,7 @@ class FolderSource final : public FrameSource {
   }
 
   std::optional<Frame> next() override {
+    waited_s_ = 0;
     for (;;) {
       while (index_ < static_cast<int>(files_.size())) {
         if (filter_.done(index_)) return std::nullopt;
@@ -372,6 +373,7 @@ class FolderSource final : public FrameSource {
         if (image.empty()) return std::nullopt;  // cancelled while the image was still being written
         f.image = to_bgr(image, f.name);
         check_size(f.image, expected_, p.string());
+        f.waited_s = waited_s_;
         return f;
       }
       if (!following() || !wait_for_more()) return std::nullopt;
@@ -488,8 +490,15 @@ class FolderSource final : public FrameSource {
         logger().info("{}: no new image for {:g} s; the run ends", dir_.string(), follow_.idle_s);
         return false;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      pause();
     }
+  }
+
+  // One poll's wait while following, counted in the frame's waited_s.
+  void pause() const {
+    const auto before = std::chrono::steady_clock::now();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    waited_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
   }
 
   // An image that does not decode is an error. Following, it may still be
@@ -532,7 +541,7 @@ class FolderSource final : public FrameSource {
       }
       if (settled) fail_to_read(p, said);
       if (follow_.cancel && follow_.cancel->load()) return {};
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      pause();
     }
   }
 
@@ -542,6 +551,7 @@ class FolderSource final : public FrameSource {
   }
 
   fs::path dir_;
+  mutable double waited_s_ = 0;  // of the frame being taken
   std::vector<fs::path> files_;
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
   bool warned_gap_ = false;

@@ -447,7 +447,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       summary.cancelled = options.follow_input_s > 0 && options.cancel && options.cancel->load();
       break;
     }
-    double io_ms = seconds_since(t_read) * 1e3;
+    double io_ms = (seconds_since(t_read) - frame->waited_s) * 1e3;
     const double time_s = frame->index / fps;
     const std::optional<double> reading = reading_at(frame->index, time_s);
 
@@ -468,7 +468,16 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       ++references_used;
     }
 
+    // The row first (and the stream's line with it): a controller gets the
+    // estimate before the overlay is drawn and encoded. The state, which
+    // says the frame is done, comes last.
     const auto t_write = Clock::now();
+    e.times.io_ms = io_ms;
+    e.image = frame->name;
+    e.unix_time_s =
+        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    results.write(e);
+    if (options.durable) results.sync();  // the rows before the state that says they are done
     if (options.save_masks) {
       char name[32];
       std::snprintf(name, sizeof name, "%06d.png", frame->index);
@@ -476,16 +485,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       if (!cv::imwrite(p.string(), tracker.last_observation().mask)) throw InputError(p.string() + ": cannot write");
     }
     if (want_overlay) overlay.write(tracker.draw_overlay(frame->image, e));
-    io_ms += seconds_since(t_write) * 1e3;
-    e.times.io_ms = io_ms;
-    e.image = frame->name;
-    e.unix_time_s =
-        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-    results.write(e);
-    if (options.durable) results.sync();  // the rows before the state that says they are done
     TrackerState state = tracker.state();
     state.run = run;
     write_tracker_state(state_file, state, options.durable);
+    io_ms += seconds_since(t_write) * 1e3;
     if (options.on_frame) options.on_frame(e);
 
     ++summary.frames;
@@ -494,7 +497,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     ms_sum += e.ms;
     sums.segment_ms += e.times.segment_ms;
     sums.pso_ms += e.times.pso_ms;
-    sums.io_ms += e.times.io_ms;
+    sums.io_ms += io_ms;
     progress.update(summary.frames, frame->index, seconds_since(start));
   }
   progress.finish();
