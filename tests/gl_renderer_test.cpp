@@ -22,6 +22,8 @@
 #include <random>
 #include <string>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 #include "support/reference_raster.hpp"
 
@@ -648,6 +650,44 @@ TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndCarriesTheLog) {
     EXPECT_NE(m.find("compile"), std::string::npos) << m;
     EXPECT_NE(m.find("error"), std::string::npos) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+// A stage is compiled from the prelude and several files: an error is named
+// by the file it is in and its line there, whichever of the stage's files
+// that is (pose.glsl comes before hypotheses.vert in the vertex stage).
+TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndLineOfTheError) {
+  const fs::path source = fs::path(GTRACK_TEST_SOURCE_DIR) / "shaders";
+  ScopedEnv shaders("GTRACK_SHADER_DIR", (dir_ / "shaders").string());
+  for (const auto& [name, line] : {std::pair<std::string, int>{"pose.glsl", 13}, {"hypotheses.vert", 12}}) {
+    SCOPED_TRACE(name);
+    for (const auto& f : fs::directory_iterator(source)) {
+      fs::copy_file(f.path(), dir_ / "shaders" / f.path().filename(), fs::copy_options::overwrite_existing);
+    }
+    // The broken line becomes line `line` of the file.
+    std::vector<std::string> lines;
+    {
+      std::ifstream in(dir_ / "shaders" / name);
+      for (std::string l; std::getline(in, l);) lines.push_back(l);
+    }
+    ASSERT_GT(lines.size(), static_cast<size_t>(line));
+    lines.insert(lines.begin() + (line - 1), "this is not glsl;");
+    {
+      std::ofstream out(dir_ / "shaders" / name, std::ios::trunc);
+      for (const std::string& l : lines) out << l << "\n";
+    }
+    try {
+      std::string skip;
+      auto r = make_gl(skip);
+      if (!r) GTEST_SKIP() << skip;
+      ADD_FAILURE() << "a broken shader compiled";
+    } catch (const gtrack::Error& e) {
+      const std::string m = e.what();
+      const std::string where = (dir_ / "shaders" / name).string() + ":" + std::to_string(line);
+      EXPECT_NE(m.find("cannot compile vertex shader " + where + ":"), std::string::npos) << m;
+      EXPECT_NE(m.find("error"), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
   }
 }
 
