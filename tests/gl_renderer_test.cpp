@@ -318,6 +318,45 @@ TEST(GlRenderer, RimCountsAgreeWithCpu) {
   EXPECT_THROW(gl->set_rim(cv::Mat::zeros(8, 8, CV_8UC1)), gtrack::Error);
 }
 
+// A new projection starts without an observation or a rim on either backend,
+// whether or not the render size changes.
+TEST(GlRenderer, ANewProjectionClearsTheObservationAndRimAsCpuDoes) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(100, 23, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(4));
+  cv::Mat rim;
+  cv::dilate(s.observation, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  rim.setTo(0, s.observation);
+  auto cpu = make_cpu();
+  std::vector<PairCounts> from_gl, from_cpu;
+  for (Renderer* r : {gl.get(), cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+    r->set_rim(rim);
+  }
+  // Uploaded to the GPU by a batch before the projection is set again.
+  gl->evaluate(H, from_gl);
+  ASSERT_GT(gl->observation_count(), 0u);
+  for (Renderer* r : {gl.get(), cpu.get()}) r->set_projection(s.projection, kScale);
+  EXPECT_EQ(gl->observation_count(), cpu->observation_count());
+  EXPECT_EQ(gl->observation_count(), 0u);
+  gl->evaluate(H, from_gl);
+  cpu->evaluate(H, from_cpu);
+  ASSERT_EQ(from_gl.size(), from_cpu.size());
+  int rendered = 0;
+  for (size_t i = 0; i < from_gl.size(); ++i) {
+    EXPECT_EQ(from_gl[i].intersection, from_cpu[i].intersection) << "hypothesis " << i;
+    EXPECT_EQ(from_gl[i].rim, from_cpu[i].rim) << "hypothesis " << i;
+    EXPECT_EQ(from_gl[i].intersection, 0u) << "hypothesis " << i;
+    EXPECT_EQ(from_gl[i].rim, 0u) << "hypothesis " << i;
+    EXPECT_TRUE(counts_agree(from_gl[i].rendered, from_cpu[i].rendered)) << "hypothesis " << i;
+    rendered += from_gl[i].rendered > 0;
+  }
+  EXPECT_GT(rendered, 50);
+}
+
 TEST(GlRenderer, TheSlabKeepsOnlyWhatIsInsideIt) {
   GL_OR_SKIP(gl);
   const ArticulatedModel model(hydrogel_geometry());

@@ -293,13 +293,15 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
     // Integer textures are incomplete (and read as 0) with linear filtering.
     gl_.TextureParameteri(observation_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl_.TextureParameteri(observation_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    const GLuint zero = 0;
-    gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
     gl_.BindTextureUnit(1, observation_);
-    observation_count_ = 0;
-    texture_bits_.release();
-    texture_dirty_ = false;
   }
+  // A new projection starts without an observation or a rim, at any size, as
+  // on the cpu backend. No batch reads the texture: the fence was waited for.
+  const GLuint zero = 0;
+  gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
+  observation_count_ = 0;
+  texture_bits_.release();
+  texture_dirty_ = false;
   gl_.check("setting the projection");
 }
 
