@@ -9,18 +9,24 @@
 // Skipped only when no EGL context can be made at all.
 #include <gtest/gtest.h>
 #include <gtrack/error.hpp>
+#include <gtrack/log.hpp>
 #include <gtrack/renderer.hpp>
 
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <random>
+#include <spdlog/sinks/ostream_sink.h>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <unistd.h>
 #include <utility>
 #include <vector>
@@ -578,6 +584,90 @@ TEST(GlRenderer, TwoRenderersInOneThreadKeepTheirOwnState) {
   second.reset();  // the display stays up for the first
   first->evaluate(H, a2);
   for (size_t i = 0; i < a1.size(); ++i) EXPECT_EQ(a1[i].rendered, a2[i].rendered);
+}
+
+// The context is left current on no thread when the renderer is made: the
+// first thread that uses the renderer takes it, even once its maker has ended.
+TEST(GlRenderer, ARendererMadeOnAThreadThatEndedWorksOnAnother) {
+  std::string skip;
+  std::unique_ptr<Renderer> gl;
+  std::exception_ptr error;
+  std::thread([&] {
+    try {
+      gl = make_gl(skip);
+    } catch (...) {
+      error = std::current_exception();
+    }
+  }).join();
+  if (error) std::rethrow_exception(error);
+  if (!gl) GTEST_SKIP() << "no EGL context: " << skip;
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(40, 25, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(4));
+  auto cpu = make_cpu();
+  for (Renderer* r : {gl.get(), cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+  }
+  std::vector<PairCounts> from_gl, from_cpu;
+  gl->evaluate(H, from_gl);
+  cpu->evaluate(H, from_cpu);
+  ASSERT_EQ(from_gl.size(), from_cpu.size());
+  for (size_t i = 0; i < from_gl.size(); ++i) {
+    EXPECT_TRUE(pair_counts_agree(from_gl[i], from_cpu[i])) << "hypothesis " << i;
+  }
+  EXPECT_TRUE(masks_agree(gl->render_mask(H.col(0)), cpu->render_mask(H.col(0))));
+}
+
+// A renderer works on a thread other than its maker's. Destroyed there, it
+// says nothing; destroyed on another thread while the one that used it still
+// holds its context, it cannot delete its objects: nothing is thrown, and a
+// warning says so.
+TEST(GlRenderer, ARendererUsedOnAnotherThreadMayBeDestroyedOnAThird) {
+  const ArticulatedModel model(hydrogel_geometry());
+  const Eigen::MatrixXd H = camera_hypotheses(40, 27, model.fingers());
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  struct PopSink {
+    ~PopSink() { gtrack::logger().sinks().pop_back(); }
+  } pop_sink;
+  for (const bool destroy_elsewhere : {false, true}) {
+    SCOPED_TRACE(destroy_elsewhere ? "destroyed on a third thread" : "destroyed by its user");
+    GL_OR_SKIP(gl);
+    log.str("");
+    std::vector<PairCounts> out;
+    std::string error;
+    std::promise<void> used, destroyed;
+    std::thread user([&] {
+      try {
+        gl->set_model(model);
+        gl->set_projection(camera(), kScale);
+        gl->evaluate(H, out);
+        if (!destroy_elsewhere) gl.reset();
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      used.set_value();
+      destroyed.get_future().wait();  // the context stays current here meanwhile
+    });
+    used.get_future().wait();
+    if (destroy_elsewhere) std::thread([&] { gl.reset(); }).join();
+    destroyed.set_value();
+    user.join();
+    EXPECT_EQ(error, "");
+    EXPECT_EQ(gl, nullptr);
+    ASSERT_EQ(out.size(), static_cast<size_t>(H.cols()));
+    int rendered = 0;
+    for (const PairCounts& c : out) rendered += c.rendered > 0;
+    EXPECT_GT(rendered, 20);
+    if (destroy_elsewhere) {
+      EXPECT_NE(log.str().find("destroyed on a thread other than the one that used it"), std::string::npos)
+          << log.str();
+    } else {
+      EXPECT_EQ(log.str().find("[warning]"), std::string::npos) << log.str();
+    }
+  }
 }
 
 TEST(GlRenderer, ReusesItsObjectsWhenSizesChange) {

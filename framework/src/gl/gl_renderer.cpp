@@ -167,6 +167,10 @@ GlRenderer::GlRenderer(const RenderOptions& options)
   gl_.check("setting up the context");
   logger().info("gl backend: {} ({}), on {}", context_.gl_renderer(), context_.gl_version(),
                  context_.display_label());
+  // Left current here, the context would be tied to this thread: another
+  // could neither use the renderer (even once this one has ended) nor delete
+  // its objects. The first thread that uses it makes it current.
+  context_.release_current();
 }
 
 GlRenderer::~GlRenderer() { release(); }
@@ -174,8 +178,13 @@ GlRenderer::~GlRenderer() { release(); }
 void GlRenderer::release() noexcept {
   try {
     context_.make_current();
-  } catch (...) {
-    return;  // the context goes with its objects
+  } catch (const std::exception& e) {
+    // Current on the thread that used the renderer: the objects go with the
+    // context, but only once that thread lets it go.
+    logger().warn("gl backend: a renderer destroyed on a thread other than the one that used it cannot delete "
+                  "its objects, whose memory is held while its context stays current there: {}",
+                  e.what());
+    return;
   }
   if (fence_ != nullptr) {
     gl_.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, 10'000'000'000ull);
