@@ -529,6 +529,9 @@ void GlRenderer::finish(std::vector<PairCounts>& out) {
   wait_for_fence();
   const int n = pending_;
   pending_ = -1;
+  // Once a batch, when its work is done: an error in drawing or counting it
+  // is reported as the batch's, not by the next setup step that checks.
+  gl_.check("drawing and counting a batch");
   out.resize(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
     const std::uint32_t* c = readback_ + kCountsPerHypothesis * i;
