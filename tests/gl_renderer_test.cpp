@@ -9,19 +9,27 @@
 // Skipped only when no EGL context can be made at all.
 #include <gtest/gtest.h>
 #include <gtrack/error.hpp>
+#include <gtrack/log.hpp>
 #include <gtrack/renderer.hpp>
 
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <random>
+#include <spdlog/sinks/ostream_sink.h>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 #include "support/reference_raster.hpp"
 
@@ -316,6 +324,45 @@ TEST(GlRenderer, RimCountsAgreeWithCpu) {
   EXPECT_THROW(gl->set_rim(cv::Mat::zeros(8, 8, CV_8UC1)), gtrack::Error);
 }
 
+// A new projection starts without an observation or a rim on either backend,
+// whether or not the render size changes.
+TEST(GlRenderer, ANewProjectionClearsTheObservationAndRimAsCpuDoes) {
+  GL_OR_SKIP(gl);
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(100, 23, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(4));
+  cv::Mat rim;
+  cv::dilate(s.observation, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  rim.setTo(0, s.observation);
+  auto cpu = make_cpu();
+  std::vector<PairCounts> from_gl, from_cpu;
+  for (Renderer* r : {gl.get(), cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+    r->set_rim(rim);
+  }
+  // Uploaded to the GPU by a batch before the projection is set again.
+  gl->evaluate(H, from_gl);
+  ASSERT_GT(gl->observation_count(), 0u);
+  for (Renderer* r : {gl.get(), cpu.get()}) r->set_projection(s.projection, kScale);
+  EXPECT_EQ(gl->observation_count(), cpu->observation_count());
+  EXPECT_EQ(gl->observation_count(), 0u);
+  gl->evaluate(H, from_gl);
+  cpu->evaluate(H, from_cpu);
+  ASSERT_EQ(from_gl.size(), from_cpu.size());
+  int rendered = 0;
+  for (size_t i = 0; i < from_gl.size(); ++i) {
+    EXPECT_EQ(from_gl[i].intersection, from_cpu[i].intersection) << "hypothesis " << i;
+    EXPECT_EQ(from_gl[i].rim, from_cpu[i].rim) << "hypothesis " << i;
+    EXPECT_EQ(from_gl[i].intersection, 0u) << "hypothesis " << i;
+    EXPECT_EQ(from_gl[i].rim, 0u) << "hypothesis " << i;
+    EXPECT_TRUE(counts_agree(from_gl[i].rendered, from_cpu[i].rendered)) << "hypothesis " << i;
+    rendered += from_gl[i].rendered > 0;
+  }
+  EXPECT_GT(rendered, 50);
+}
+
 TEST(GlRenderer, TheSlabKeepsOnlyWhatIsInsideIt) {
   GL_OR_SKIP(gl);
   const ArticulatedModel model(hydrogel_geometry());
@@ -539,6 +586,90 @@ TEST(GlRenderer, TwoRenderersInOneThreadKeepTheirOwnState) {
   for (size_t i = 0; i < a1.size(); ++i) EXPECT_EQ(a1[i].rendered, a2[i].rendered);
 }
 
+// The context is left current on no thread when the renderer is made: the
+// first thread that uses the renderer takes it, even once its maker has ended.
+TEST(GlRenderer, ARendererMadeOnAThreadThatEndedWorksOnAnother) {
+  std::string skip;
+  std::unique_ptr<Renderer> gl;
+  std::exception_ptr error;
+  std::thread([&] {
+    try {
+      gl = make_gl(skip);
+    } catch (...) {
+      error = std::current_exception();
+    }
+  }).join();
+  if (error) std::rethrow_exception(error);
+  if (!gl) GTEST_SKIP() << "no EGL context: " << skip;
+  Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
+  const Eigen::MatrixXd H = camera_hypotheses(40, 25, s.model.fingers());
+  s.observation = observation_for(s, H.leftCols(4));
+  auto cpu = make_cpu();
+  for (Renderer* r : {gl.get(), cpu.get()}) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+  }
+  std::vector<PairCounts> from_gl, from_cpu;
+  gl->evaluate(H, from_gl);
+  cpu->evaluate(H, from_cpu);
+  ASSERT_EQ(from_gl.size(), from_cpu.size());
+  for (size_t i = 0; i < from_gl.size(); ++i) {
+    EXPECT_TRUE(pair_counts_agree(from_gl[i], from_cpu[i])) << "hypothesis " << i;
+  }
+  EXPECT_TRUE(masks_agree(gl->render_mask(H.col(0)), cpu->render_mask(H.col(0))));
+}
+
+// A renderer works on a thread other than its maker's. Destroyed there, it
+// says nothing; destroyed on another thread while the one that used it still
+// holds its context, it cannot delete its objects: nothing is thrown, and a
+// warning says so.
+TEST(GlRenderer, ARendererUsedOnAnotherThreadMayBeDestroyedOnAThird) {
+  const ArticulatedModel model(hydrogel_geometry());
+  const Eigen::MatrixXd H = camera_hypotheses(40, 27, model.fingers());
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  struct PopSink {
+    ~PopSink() { gtrack::logger().sinks().pop_back(); }
+  } pop_sink;
+  for (const bool destroy_elsewhere : {false, true}) {
+    SCOPED_TRACE(destroy_elsewhere ? "destroyed on a third thread" : "destroyed by its user");
+    GL_OR_SKIP(gl);
+    log.str("");
+    std::vector<PairCounts> out;
+    std::string error;
+    std::promise<void> used, destroyed;
+    std::thread user([&] {
+      try {
+        gl->set_model(model);
+        gl->set_projection(camera(), kScale);
+        gl->evaluate(H, out);
+        if (!destroy_elsewhere) gl.reset();
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      used.set_value();
+      destroyed.get_future().wait();  // the context stays current here meanwhile
+    });
+    used.get_future().wait();
+    if (destroy_elsewhere) std::thread([&] { gl.reset(); }).join();
+    destroyed.set_value();
+    user.join();
+    EXPECT_EQ(error, "");
+    EXPECT_EQ(gl, nullptr);
+    ASSERT_EQ(out.size(), static_cast<size_t>(H.cols()));
+    int rendered = 0;
+    for (const PairCounts& c : out) rendered += c.rendered > 0;
+    EXPECT_GT(rendered, 20);
+    if (destroy_elsewhere) {
+      EXPECT_NE(log.str().find("destroyed on a thread other than the one that used it"), std::string::npos)
+          << log.str();
+    } else {
+      EXPECT_EQ(log.str().find("[warning]"), std::string::npos) << log.str();
+    }
+  }
+}
+
 TEST(GlRenderer, ReusesItsObjectsWhenSizesChange) {
   GL_OR_SKIP(gl);
   const ArticulatedModel model(hydrogel_geometry());
@@ -648,6 +779,44 @@ TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndCarriesTheLog) {
     EXPECT_NE(m.find("compile"), std::string::npos) << m;
     EXPECT_NE(m.find("error"), std::string::npos) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+// A stage is compiled from the prelude and several files: an error is named
+// by the file it is in and its line there, whichever of the stage's files
+// that is (pose.glsl comes before hypotheses.vert in the vertex stage).
+TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndLineOfTheError) {
+  const fs::path source = fs::path(GTRACK_TEST_SOURCE_DIR) / "shaders";
+  ScopedEnv shaders("GTRACK_SHADER_DIR", (dir_ / "shaders").string());
+  for (const auto& [name, line] : {std::pair<std::string, int>{"pose.glsl", 13}, {"hypotheses.vert", 12}}) {
+    SCOPED_TRACE(name);
+    for (const auto& f : fs::directory_iterator(source)) {
+      fs::copy_file(f.path(), dir_ / "shaders" / f.path().filename(), fs::copy_options::overwrite_existing);
+    }
+    // The broken line becomes line `line` of the file.
+    std::vector<std::string> lines;
+    {
+      std::ifstream in(dir_ / "shaders" / name);
+      for (std::string l; std::getline(in, l);) lines.push_back(l);
+    }
+    ASSERT_GT(lines.size(), static_cast<size_t>(line));
+    lines.insert(lines.begin() + (line - 1), "this is not glsl;");
+    {
+      std::ofstream out(dir_ / "shaders" / name, std::ios::trunc);
+      for (const std::string& l : lines) out << l << "\n";
+    }
+    try {
+      std::string skip;
+      auto r = make_gl(skip);
+      if (!r) GTEST_SKIP() << skip;
+      ADD_FAILURE() << "a broken shader compiled";
+    } catch (const gtrack::Error& e) {
+      const std::string m = e.what();
+      const std::string where = (dir_ / "shaders" / name).string() + ":" + std::to_string(line);
+      EXPECT_NE(m.find("cannot compile vertex shader " + where + ":"), std::string::npos) << m;
+      EXPECT_NE(m.find("error"), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
   }
 }
 

@@ -52,6 +52,7 @@ class GTRACK_API Renderer {
 
   virtual std::string name() const = 0;
   virtual void set_model(const ArticulatedModel& model) = 0;
+  // Clears the observation and the rim, whether or not the render size changes.
   virtual void set_projection(const Projection& projection, double scale) = 0;
   virtual ImageSize render_size() const = 0;
   // CV_8U at render_size(); non-zero pixels belong to the observation.

@@ -214,10 +214,16 @@ void EglContext::make_current() const {
   if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
     const EGLint e = eglGetError();
     throw Error("gl backend: eglMakeCurrent failed with " + egl_error_name(e) +
-                (e == EGL_BAD_ACCESS ? std::string(" (its context stays current on the thread that created the "
-                                                   "renderer: a gl renderer is used from that thread only)")
+                (e == EGL_BAD_ACCESS ? std::string(" (its context is current on another thread: a gl renderer is "
+                                                   "used from the first thread that uses it only)")
                                      : std::string()));
   }
+}
+
+void EglContext::release_current() const noexcept {
+  if (context_ == EGL_NO_CONTEXT) return;
+  if (eglQueryAPI() != EGL_OPENGL_API) eglBindAPI(EGL_OPENGL_API);
+  if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
 bool EglContext::software() const {

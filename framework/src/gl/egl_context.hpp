@@ -9,7 +9,9 @@
 // made in the context must be deleted before it goes (with it current).
 //
 // A context is current on at most one thread; callers make it current at the
-// entry of every operation (cheap when it already is).
+// entry of every operation (cheap when it already is). open() leaves it
+// current on the calling thread; release_current() lets it go, so that
+// another thread can take it.
 #pragma once
 
 #include <EGL/egl.h>
@@ -55,6 +57,8 @@ class EglContext {
   // Throws gtrack::Error with the EGL error name on failure (for example
   // EGL_BAD_ACCESS when the context is current on another thread).
   void make_current() const;
+  // Makes no context current on the calling thread if this one is.
+  void release_current() const noexcept;
 
   const std::string& display_label() const { return label_; }
   const std::string& gl_renderer() const { return renderer_; }

@@ -87,7 +87,8 @@ struct Api {
   void load();
 
   // Throws gtrack::Error "gl backend: <what>: GL_INVALID_..." if the GL error
-  // flag is set. Not for hot paths: callers check after setup steps.
+  // flag is set. Not for every call: callers check after setup steps, and
+  // once a batch, after its fence.
   void check(const char* what) const;
 
   bool has_extension(const char* name) const;

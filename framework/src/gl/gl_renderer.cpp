@@ -167,6 +167,10 @@ GlRenderer::GlRenderer(const RenderOptions& options)
   gl_.check("setting up the context");
   logger().info("gl backend: {} ({}), on {}", context_.gl_renderer(), context_.gl_version(),
                  context_.display_label());
+  // Left current here, the context would be tied to this thread: another
+  // could neither use the renderer (even once this one has ended) nor delete
+  // its objects. The first thread that uses it makes it current.
+  context_.release_current();
 }
 
 GlRenderer::~GlRenderer() { release(); }
@@ -174,8 +178,13 @@ GlRenderer::~GlRenderer() { release(); }
 void GlRenderer::release() noexcept {
   try {
     context_.make_current();
-  } catch (...) {
-    return;  // the context goes with its objects
+  } catch (const std::exception& e) {
+    // Current on the thread that used the renderer: the objects go with the
+    // context, but only once that thread lets it go.
+    logger().warn("gl backend: a renderer destroyed on a thread other than the one that used it cannot delete "
+                  "its objects, whose memory is held while its context stays current there: {}",
+                  e.what());
+    return;
   }
   if (fence_ != nullptr) {
     gl_.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, 10'000'000'000ull);
@@ -293,13 +302,15 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
     // Integer textures are incomplete (and read as 0) with linear filtering.
     gl_.TextureParameteri(observation_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl_.TextureParameteri(observation_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    const GLuint zero = 0;
-    gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
     gl_.BindTextureUnit(1, observation_);
-    observation_count_ = 0;
-    texture_bits_.release();
-    texture_dirty_ = false;
   }
+  // A new projection starts without an observation or a rim, at any size, as
+  // on the cpu backend. No batch reads the texture: the fence was waited for.
+  const GLuint zero = 0;
+  gl_.ClearTexSubImage(observation_, 0, 0, 0, 0, w, h, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &zero);
+  observation_count_ = 0;
+  texture_bits_.release();
+  texture_dirty_ = false;
   gl_.check("setting the projection");
 }
 
@@ -518,6 +529,9 @@ void GlRenderer::finish(std::vector<PairCounts>& out) {
   wait_for_fence();
   const int n = pending_;
   pending_ = -1;
+  // Once a batch, when its work is done: an error in drawing or counting it
+  // is reported as the batch's, not by the next setup step that checks.
+  gl_.check("drawing and counting a batch");
   out.resize(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
     const std::uint32_t* c = readback_ + kCountsPerHypothesis * i;

@@ -10,6 +10,13 @@
 // returns; finish() waits on the fence once and reads the counts from the
 // mapping. The model, the projection and the observation stay on the GPU
 // until they change.
+//
+// Threads: the constructor leaves the context current on no thread; the first
+// thread that calls the renderer makes it current and keeps it, and is the
+// only one that may use the renderer from then on (another gets
+// EGL_BAD_ACCESS). Destroyed on another thread, the renderer cannot delete its
+// objects (a warning says so): they are freed with the context once the thread
+// that used it makes it current no more.
 #pragma once
 
 #include <cstdint>

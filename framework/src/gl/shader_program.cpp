@@ -51,6 +51,33 @@ std::string one_line(std::string log) {
   return out;
 }
 
+// Where the first error of a driver's log is: the source string's number and
+// the line in it, as Mesa ("2:13(5): error: ..."), NVIDIA ("2(13) : error
+// C0000: ...") and others ("ERROR: 2:13: ...") write them. Warnings are
+// skipped. False when no error line has one of these forms.
+bool first_error_place(const std::string& log, int& string_number, int& line) {
+  std::istringstream lines(log);
+  for (std::string l; std::getline(lines, l);) {
+    if (l.find("error") == std::string::npos && l.find("ERROR") == std::string::npos) continue;
+    const size_t prefix = l.rfind("ERROR: ", 0) == 0 ? 7 : 0;
+    const char* p = l.c_str() + prefix;
+    while (*p == ' ') ++p;
+    char* end = nullptr;
+    const long k = std::strtol(p, &end, 10);
+    if (end == p || k < 0) continue;
+    const char* q = end;
+    if (*q != ':' && *q != '(') continue;
+    const long n = std::strtol(q + 1, &end, 10);
+    if (end == q + 1 || n < 0) continue;
+    if (*q == '(' && *end != ')') continue;
+    if (*q == ':' && *end != '(' && *end != ':') continue;
+    string_number = static_cast<int>(k);
+    line = static_cast<int>(n);
+    return true;
+  }
+  return false;
+}
+
 const char* stage_name(GLenum type) {
   switch (type) {
     case GL_VERTEX_SHADER: return "vertex";
@@ -86,14 +113,21 @@ GLuint build_program(const Api& gl, const std::string& prelude, const std::vecto
       cleanup(0);
       throw;
     }
-    std::vector<const GLchar*> strings{prelude.c_str()};
+    // File k is source string k, its lines counted from 1: drivers count on
+    // from the start of string 0 otherwise (Mesa does), and report that. The
+    // #line directive comes after the prelude's #version, which must be first;
+    // the newline before it ends a file whose last line has none.
+    std::vector<std::string> texts;
     std::string legend = "source strings: 0 = prelude";
+    std::string stage_files;
     for (size_t i = 0; i < files.size(); ++i) {
-      strings.push_back(files[i].text.c_str());
+      texts.push_back("\n#line 1 " + std::to_string(i + 1) + "\n" + files[i].text);
       legend += ", " + std::to_string(i + 1) + " = " + files[i].path.filename().string();
+      stage_files += (stage_files.empty() ? "" : ", ") + files[i].path.string();
     }
-    const fs::path& main_file = files.back().path;
-    all_files += (all_files.empty() ? "" : ", ") + main_file.string();
+    all_files += (all_files.empty() ? "" : ", ") + stage_files;
+    std::vector<const GLchar*> strings{prelude.c_str()};
+    for (const std::string& t : texts) strings.push_back(t.c_str());
 
     const GLuint shader = gl.CreateShader(stage.type);
     shaders.push_back(shader);
@@ -106,8 +140,19 @@ GLuint build_program(const Api& gl, const std::string& prelude, const std::vecto
       std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
       gl.GetShaderInfoLog(shader, length, nullptr, log.data());
       cleanup(0);
-      throw Error("gl backend: cannot compile " + std::string(stage_name(stage.type)) + " shader " +
-                  main_file.string() + ": " + one_line(log) + " (" + legend + ")");
+      // The file and line of the first error, when the log says which they
+      // are; the stage's files otherwise.
+      std::string where = "of " + stage_files;
+      int string_number = -1, line = 0;
+      if (first_error_place(log, string_number, line)) {
+        if (string_number >= 1 && static_cast<size_t>(string_number) <= files.size()) {
+          where = files[static_cast<size_t>(string_number - 1)].path.string() + ":" + std::to_string(line);
+        } else if (string_number == 0) {
+          where = "prelude:" + std::to_string(line);
+        }
+      }
+      throw Error("gl backend: cannot compile " + std::string(stage_name(stage.type)) + " shader " + where +
+                  ": " + one_line(log) + " (" + legend + ")");
     }
   }
 

@@ -5,8 +5,10 @@
 // stage is compiled from several source strings: a prelude made in C++
 // (#version, #extension, #define of feature flags and sizes) followed by the
 // files in order, so that shared code such as the posing math lives in one
-// file. Driver logs name a source string by number; error messages therefore
-// list which number is which file.
+// file. Each file is source string k (the prelude is 0) and starts with
+// "#line 1 k", so driver logs count its lines from its own start; an error
+// message names the file and line of the first error, and lists which number
+// is which file.
 #pragma once
 
 #include <filesystem>
@@ -26,7 +28,8 @@ struct ShaderStage {
 std::vector<std::filesystem::path> shader_search_dirs();
 
 // Compiles and links; returns the program name. Throws gtrack::Error naming
-// the file and carrying the driver's log (on one line) on failure, or the
+// the file and line of a compile error (the stage's files when the log's form
+// is not known) and carrying the driver's log (on one line) on failure, or the
 // folders searched when a file is missing.
 GLuint build_program(const Api& gl, const std::string& prelude, const std::vector<ShaderStage>& stages);
 

@@ -24,6 +24,7 @@ void OpenCvBaseline::set_projection(const Projection& projection, double scale) 
   const ImageSize s = projection_.size;
   observation_ = cv::Mat(s.height, s.width, CV_8UC1, cv::Scalar(0));
   observation_count_ = 0;
+  rim_.release();
   for (Scratch& sc : scratch_) sc.mask = cv::Mat(s.height, s.width, CV_8UC1, cv::Scalar(0));
   has_projection_ = true;
 }
