@@ -336,7 +336,8 @@ TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
 }
 
 // A folder whose image becomes unreadable part way: the run stops at that
-// frame with one line naming the file; the frames before it are in the CSV.
+// frame with one line naming the file; the frames before it are in the CSV,
+// and the summary says what stopped it.
 TEST(Fault, CorruptImageInFolderStopsWithTheFramesBefore) {
   const fs::path dir = fresh_dir("corrupt_image");
   const fs::path frames = write_frames(dir / "frames", kFrames);
@@ -349,6 +350,11 @@ TEST(Fault, CorruptImageInFolderStopsWithTheFramesBefore) {
   o.progress = false;
   expect_refusal_naming(track_error(r, o), "000005.png");
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), (std::vector<int>{0, 1, 2, 3, 4}));
+  // The summary says what stopped the run, with the frames done.
+  const std::string summary = read_text(o.out_dir / "summary.json");
+  EXPECT_NE(summary.find("\"frames\": 5,"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"stopped_by\": \""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("000005.png: cannot read the image"), std::string::npos) << summary;
 }
 
 // A stimulus log shorter than the video: every frame is tracked, the frames

@@ -223,6 +223,7 @@ struct TrackSummary {
   int resumed_after = -1;    // --resume: the last frame done before this run (-1: a fresh run)
   int frames_before = 0;     // --resume: rows kept from before; `frames` counts this run's only
   std::string input_ended_early;  // FrameSource::ended_early: "" when the input ended where it said it would
+  std::string stopped_by;    // the error that stopped the run part way ("" when none; it is then thrown on)
 };
 
 // Runs the tracker over a source and writes, in options.out_dir:

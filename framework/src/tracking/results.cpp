@@ -176,7 +176,8 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
       << "  \"frames_before_resume\": " << s.frames_before << ",\n"
       << "  \"cancelled\": " << (s.cancelled ? "true" : "false") << ",\n"
       << "  \"input_ended_early\": " << (s.input_ended_early.empty() ? "null" : json_string(s.input_ended_early))
-      << "\n"
+      << ",\n"
+      << "  \"stopped_by\": " << (s.stopped_by.empty() ? "null" : json_string(s.stopped_by)) << "\n"
       << "}\n";
   // Whole or not at all: a full disk is an error, and an earlier summary
   // stays until the new one is complete.

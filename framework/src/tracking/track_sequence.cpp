@@ -434,84 +434,107 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   StageTimes sums;
   int previous_index = -1;  // the last frame tracked by this run
   ObservationAdvice advice(config.observation);
-  for (;;) {
-    if (options.cancel && options.cancel->load()) {
-      summary.cancelled = true;
-      break;
-    }
-    const auto t_read = Clock::now();
-    std::optional<Frame> frame = source->next();
-    if (!frame) {
-      // A followed folder's wait ends at a cancel as at its idle limit; any
-      // other source has simply ended.
-      summary.cancelled = options.follow_input_s > 0 && options.cancel && options.cancel->load();
-      break;
-    }
-    double io_ms = (seconds_since(t_read) - frame->waited_s) * 1e3;
-    const double time_s = frame->index / fps;
-    const std::optional<double> reading = reading_at(frame->index, time_s);
+  // The files closed and the summary's figures taken, at the end or at an
+  // error that stops the run.
+  const auto finish = [&] {
+    progress.finish();
+    results.close();
+    overlay.close();
+    const int n = std::max(1, summary.frames);
+    const int found = summary.frames - summary.lost_frames;
+    summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
+    summary.input_ended_early = source->ended_early();
+    summary.mean_ms = ms_sum / n;
+    summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
+    summary.wall_s = seconds_since(start);
+    summary.overlay_file = overlay.file();
+  };
+  try {
+    for (;;) {
+      if (options.cancel && options.cancel->load()) {
+        summary.cancelled = true;
+        break;
+      }
+      const auto t_read = Clock::now();
+      std::optional<Frame> frame = source->next();
+      if (!frame) {
+        // A followed folder's wait ends at a cancel as at its idle limit; any
+        // other source has simply ended.
+        summary.cancelled = options.follow_input_s > 0 && options.cancel && options.cancel->load();
+        break;
+      }
+      double io_ms = (seconds_since(t_read) - frame->waited_s) * 1e3;
+      const double time_s = frame->index / fps;
+      const std::optional<double> reading = reading_at(frame->index, time_s);
 
-    if (!restart_rows.empty()) {
-      const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
-      if (row != restart_rows.end()) {
-        tracker.set_estimate(row->second);
-        ++restarts_used;
+      if (!restart_rows.empty()) {
+        const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
+        if (row != restart_rows.end()) {
+          tracker.set_estimate(row->second);
+          ++restarts_used;
+        }
+      }
+      Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
+      advice.after(*frame, e, tracker.last_observation(), summary.frames == 0);
+      previous_index = frame->index;
+      if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
+        // Of the reference's symmetric equivalents, the one nearest the estimate.
+        const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis, view);
+        e.reference_terms = tracker.score(reference);
+        ++references_used;
+      }
+
+      // The row first (and the stream's line with it): a controller gets the
+      // estimate before the overlay is drawn and encoded. The state, which
+      // says the frame is done, comes last.
+      const auto t_write = Clock::now();
+      e.times.io_ms = io_ms;
+      e.image = frame->name;
+      e.unix_time_s =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+      results.write(e);
+      if (options.durable) results.sync();  // the rows before the state that says they are done
+      if (options.save_masks) {
+        char name[32];
+        std::snprintf(name, sizeof name, "%06d.png", frame->index);
+        const fs::path p = options.out_dir / "masks" / name;
+        if (!cv::imwrite(p.string(), tracker.last_observation().mask)) throw InputError(p.string() + ": cannot write");
+      }
+      if (want_overlay) overlay.write(tracker.draw_overlay(frame->image, e));
+      TrackerState state = tracker.state();
+      state.run = run;
+      write_tracker_state(state_file, state, options.durable);
+      io_ms += seconds_since(t_write) * 1e3;
+      if (options.on_frame) options.on_frame(e);
+
+      ++summary.frames;
+      if (e.status == TrackStatus::Lost) ++summary.lost_frames;
+      else cost_sum += e.terms.total;
+      ms_sum += e.ms;
+      sums.segment_ms += e.times.segment_ms;
+      sums.pso_ms += e.times.pso_ms;
+      sums.io_ms += io_ms;
+      progress.update(summary.frames, frame->index, seconds_since(start));
+    }
+  } catch (const std::exception& e) {
+    // An error part way (an unreadable image, a log that shrank): the
+    // frames done stay, the summary says what stopped the run, and one line
+    // says where they are before the error's own.
+    if (summary.frames > 0) {
+      try {
+        summary.stopped_by = e.what();
+        finish();
+        write_summary(options.out_dir / "summary.json", summary);
+        logger().warn("the run stopped at an error after {} frames; they are kept in {} (--resume goes on from the "
+                      "last once the cause is mended)",
+                      summary.frames, options.out_dir.string());
+      } catch (const std::exception&) {
+        // The error that stopped the run is the one to report.
       }
     }
-    Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
-    advice.after(*frame, e, tracker.last_observation(), summary.frames == 0);
-    previous_index = frame->index;
-    if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
-      // Of the reference's symmetric equivalents, the one nearest the estimate.
-      const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis, view);
-      e.reference_terms = tracker.score(reference);
-      ++references_used;
-    }
-
-    // The row first (and the stream's line with it): a controller gets the
-    // estimate before the overlay is drawn and encoded. The state, which
-    // says the frame is done, comes last.
-    const auto t_write = Clock::now();
-    e.times.io_ms = io_ms;
-    e.image = frame->name;
-    e.unix_time_s =
-        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-    results.write(e);
-    if (options.durable) results.sync();  // the rows before the state that says they are done
-    if (options.save_masks) {
-      char name[32];
-      std::snprintf(name, sizeof name, "%06d.png", frame->index);
-      const fs::path p = options.out_dir / "masks" / name;
-      if (!cv::imwrite(p.string(), tracker.last_observation().mask)) throw InputError(p.string() + ": cannot write");
-    }
-    if (want_overlay) overlay.write(tracker.draw_overlay(frame->image, e));
-    TrackerState state = tracker.state();
-    state.run = run;
-    write_tracker_state(state_file, state, options.durable);
-    io_ms += seconds_since(t_write) * 1e3;
-    if (options.on_frame) options.on_frame(e);
-
-    ++summary.frames;
-    if (e.status == TrackStatus::Lost) ++summary.lost_frames;
-    else cost_sum += e.terms.total;
-    ms_sum += e.ms;
-    sums.segment_ms += e.times.segment_ms;
-    sums.pso_ms += e.times.pso_ms;
-    sums.io_ms += io_ms;
-    progress.update(summary.frames, frame->index, seconds_since(start));
+    throw;
   }
-  progress.finish();
-  results.close();
-  overlay.close();
-
-  const int n = std::max(1, summary.frames);
-  const int found = summary.frames - summary.lost_frames;
-  summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
-  summary.input_ended_early = source->ended_early();
-  summary.mean_ms = ms_sum / n;
-  summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
-  summary.wall_s = seconds_since(start);
-  summary.overlay_file = overlay.file();
+  finish();
   // A table of other frames (renumbered, another sequence's) changes nothing: said.
   const auto warn_unused = [&](const std::optional<std::filesystem::path>& file, const std::map<int, Eigen::VectorXd>& rows,
                                int used, const char* option, const char* matched) {
