@@ -1,7 +1,8 @@
 // gtrack bench: throughput of every render backend and of the OpenCV
 // baseline, in one run, on the same scene (bench.hpp): the hydrogel gripper
-// ~114 px across at 256x256. Hypotheses per second for batches of 32, and
-// frames per second of the paper's PSO (N = 32, G = 25) per backend.
+// ~114 px across at 256x256. Hypotheses per second for batches of --batch
+// (32), and frames per second of the paper's PSO (N = 32, G = 25) per
+// backend.
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -78,6 +79,8 @@ std::unique_ptr<gtrack::Renderer> try_make(Make make, int threads, std::string& 
 int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   const double seconds = vm["seconds"].as<double>();
   if (!(seconds > 0 && seconds <= 3600)) throw gtrack::cli::UsageError("--seconds must be in (0, 3600]");
+  const int batch = vm["batch"].as<int>();
+  if (batch < 1 || batch > 4096) throw gtrack::cli::UsageError("--batch must be in 1-4096 hypotheses");
   const bool json = vm.count("json") > 0;
   const int all = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
@@ -87,7 +90,9 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::logger().info("bench: {} at {}x{}, {:.0f} px across, {} s per measurement", gripper_source, kSide, kSide,
                         kGripperPx, seconds);
 
-  auto hypotheses = [&](gtrack::Renderer& r) { return gtrack::measure_hypotheses(r, scene, seconds).per_second; };
+  auto hypotheses = [&](gtrack::Renderer& r) {
+    return gtrack::measure_hypotheses(r, scene, seconds, batch).per_second;
+  };
   auto frames = [&](gtrack::Renderer& r) { return gtrack::measure_pso_frames(r, scene, seconds).per_second; };
 
   Measured cpu1, cpu_all, cpu_frames, base1, base_all, gl, gl_frames;
@@ -134,7 +139,7 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
               << all << "\": " << json_number(base_all.value) << "},\n"
               << " \"cpu_over_opencv_baseline\": {\"1\": " << json_number(ratio_one) << ", \"" << all
               << "\": " << json_number(ratio_all) << "},\n"
-              << " \"threads\": " << all << ", \"batch\": 32, \"render_size\": [" << kSide << ", " << kSide
+              << " \"threads\": " << all << ", \"batch\": " << batch << ", \"render_size\": [" << kSide << ", " << kSide
               << "], \"gripper_px\": " << kGripperPx << ", \"gripper\": " << json_string(gripper_source)
               << ", \"seconds_per_measurement\": " << seconds;
     if (!gl.value) std::cout << ",\n \"gl_unavailable\": " << json_string(gl.note);
@@ -142,8 +147,8 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
     return 0;
   }
 
-  std::printf("gtrack bench: %s, %dx%d render, gripper ~%.0f px across, batches of 32\n\n", gripper_source.c_str(),
-              kSide, kSide, kGripperPx);
+  std::printf("gtrack bench: %s, %dx%d render, gripper ~%.0f px across, batches of %d\n\n", gripper_source.c_str(),
+              kSide, kSide, kGripperPx, batch);
   std::printf("%-18s %12s %14s %16s\n", "backend", "threads", "hypotheses/s", "PSO frames/s");
   std::printf("%-18s %12d %14s %16s\n", "cpu", 1, human(cpu1.value).c_str(), "");
   std::printf("%-18s %12d %14s %16s\n", "cpu", all, human(cpu_all.value).c_str(), human(cpu_frames.value).c_str());
@@ -161,6 +166,8 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
 GTRACK_COMMAND("bench", "throughput of every render backend and of the OpenCV baseline, in one run",
                [](po::options_description& d) {
                  d.add_options()("json", "print one JSON object instead of a table")(
-                     "seconds", po::value<double>()->default_value(1.0), "time spent on each measurement");
+                     "seconds", po::value<double>()->default_value(1.0), "time spent on each measurement")(
+                     "batch", po::value<int>()->default_value(32),
+                     "hypotheses per batch for hypotheses/s (a swarm's N; PSO frames/s keep N = 32)");
                },
                run_bench, {})

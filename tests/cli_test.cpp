@@ -839,6 +839,9 @@ TEST(Cli, UsageErrors) {
   r = gtrack("bench --seconds 1e300");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--seconds must be in (0, 3600]"), std::string::npos) << r.output;
+  r = gtrack("bench --batch 0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--batch must be in 1-4096 hypotheses"), std::string::npos) << r.output;
 }
 
 // sweep checks its config and its output folder before it makes any
