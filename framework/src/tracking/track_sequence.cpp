@@ -518,20 +518,21 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
   } catch (const std::exception& e) {
     // An error part way (an unreadable image, a log that shrank): the
-    // frames done stay, the summary says what stopped the run, and one line
-    // says where they are before the error's own.
-    if (summary.frames > 0) {
-      try {
-        summary.stopped_by = e.what();
-        finish();
-        write_summary(options.out_dir / "summary.json", summary);
-        logger().warn("the run stopped at an error after {} frames; they are kept in {} (--resume goes on from the "
-                      "last once the cause is mended)",
-                      summary.frames, options.out_dir.string());
-      } catch (const std::exception&) {
-        // The error that stopped the run is the one to report.
-      }
+    // frames done stay, the summary says what stopped the run, and the
+    // error, still one line, says where they are.
+    if (summary.frames == 0) throw;
+    std::string kept;
+    try {
+      summary.stopped_by = e.what();
+      finish();
+      write_summary(options.out_dir / "summary.json", summary);
+      kept = fmt::format("; the {} frame{} before it {} kept in {} (--resume goes on once the cause is mended)",
+                         summary.frames, summary.frames == 1 ? "" : "s", summary.frames == 1 ? "is" : "are",
+                         options.out_dir.string());
+    } catch (const std::exception&) {
+      // The error that stopped the run is the one to report.
     }
+    if (!kept.empty() && dynamic_cast<const InputError*>(&e)) throw InputError(e.what() + kept);
     throw;
   }
   finish();
