@@ -196,6 +196,23 @@ struct Scene {
   cv::Mat observation;    // at render size
 };
 
+// The scene given to each renderer: model, projection at kScale, observation.
+void set_scene(std::initializer_list<Renderer*> renderers, const Scene& s) {
+  for (Renderer* r : renderers) {
+    r->set_model(s.model);
+    r->set_projection(s.projection, kScale);
+    r->set_observation(s.observation);
+  }
+}
+
+// The one-pixel ring around an observation, as an occlusion rim.
+cv::Mat ring_around(const cv::Mat& observation) {
+  cv::Mat rim;
+  cv::dilate(observation, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  rim.setTo(0, observation);
+  return rim;
+}
+
 // An observation that overlaps many hypotheses: the union of a few posed
 // grippers, as the oracle renders them.
 cv::Mat observation_for(const Scene& s, const Eigen::MatrixXd& poses) {
@@ -209,11 +226,7 @@ cv::Mat observation_for(const Scene& s, const Eigen::MatrixXd& poses) {
 // batched counts of gl against the cpu's.
 void expect_agreement(Renderer& gl, const Scene& s, const Eigen::MatrixXd& H, int oracle_every) {
   auto cpu = make_cpu();
-  for (Renderer* r : {&gl, cpu.get()}) {
-    r->set_model(s.model);
-    r->set_projection(s.projection, kScale);
-    r->set_observation(s.observation);
-  }
+  set_scene({&gl, cpu.get()}, s);
   ASSERT_EQ(gl.render_size().width, cpu->render_size().width);
   ASSERT_EQ(gl.render_size().height, cpu->render_size().height);
   EXPECT_EQ(gl.observation_count(), cpu->observation_count());
@@ -292,16 +305,10 @@ TEST(GlRenderer, RimCountsAgreeWithCpu) {
   Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
   const Eigen::MatrixXd H = camera_hypotheses(300, 17, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(3));
-  cv::Mat rim;
-  cv::dilate(s.observation, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-  rim.setTo(0, s.observation);
+  const cv::Mat rim = ring_around(s.observation);
   auto cpu = make_cpu();
-  for (Renderer* r : {gl.get(), cpu.get()}) {
-    r->set_model(s.model);
-    r->set_projection(s.projection, kScale);
-    r->set_observation(s.observation);
-    r->set_rim(rim);
-  }
+  set_scene({gl.get(), cpu.get()}, s);
+  for (Renderer* r : {gl.get(), cpu.get()}) r->set_rim(rim);
   std::vector<PairCounts> from_gl, from_cpu;
   gl->evaluate(H, from_gl);
   cpu->evaluate(H, from_cpu);
@@ -331,17 +338,11 @@ TEST(GlRenderer, ANewProjectionClearsTheObservationAndRimAsCpuDoes) {
   Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
   const Eigen::MatrixXd H = camera_hypotheses(100, 23, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(4));
-  cv::Mat rim;
-  cv::dilate(s.observation, rim, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-  rim.setTo(0, s.observation);
+  const cv::Mat rim = ring_around(s.observation);
   auto cpu = make_cpu();
   std::vector<PairCounts> from_gl, from_cpu;
-  for (Renderer* r : {gl.get(), cpu.get()}) {
-    r->set_model(s.model);
-    r->set_projection(s.projection, kScale);
-    r->set_observation(s.observation);
-    r->set_rim(rim);
-  }
+  set_scene({gl.get(), cpu.get()}, s);
+  for (Renderer* r : {gl.get(), cpu.get()}) r->set_rim(rim);
   // Uploaded to the GPU by a batch before the projection is set again.
   gl->evaluate(H, from_gl);
   ASSERT_GT(gl->observation_count(), 0u);
@@ -490,11 +491,7 @@ TEST(GlRenderer, ABatchAfterALargerOneSeesNothingOfIt) {
   const Eigen::MatrixXd H = camera_hypotheses(130, 5, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(8));
   auto cpu = make_cpu();
-  for (Renderer* r : {gl.get(), cpu.get()}) {
-    r->set_model(s.model);
-    r->set_projection(s.projection, kScale);
-    r->set_observation(s.observation);
-  }
+  set_scene({gl.get(), cpu.get()}, s);
   std::vector<PairCounts> want, got;
   cpu->evaluate(H, want);
   // Large, smaller, one, larger again, and the layer boundaries in between.
@@ -605,11 +602,7 @@ TEST(GlRenderer, ARendererMadeOnAThreadThatEndedWorksOnAnother) {
   const Eigen::MatrixXd H = camera_hypotheses(40, 25, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(4));
   auto cpu = make_cpu();
-  for (Renderer* r : {gl.get(), cpu.get()}) {
-    r->set_model(s.model);
-    r->set_projection(s.projection, kScale);
-    r->set_observation(s.observation);
-  }
+  set_scene({gl.get(), cpu.get()}, s);
   std::vector<PairCounts> from_gl, from_cpu;
   gl->evaluate(H, from_gl);
   cpu->evaluate(H, from_cpu);
