@@ -17,6 +17,10 @@ for ex in light_stimulus three_finger_gripper telecentric_sensor; do
   cmake -S "examples/$ex" -B "$work/$ex" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > "$work/$ex.log"
   cmake --build "$work/$ex" >> "$work/$ex.log"
 done
+# Installed beside gtrack's own plugins, a plugin is found without a path.
+cmake --install "$work/light_stimulus" >> "$work/light_stimulus.log"
+env -u GTRACK_PLUGIN_PATH "$gtrack" plugins | grep -q $'^stimulus\tlight_intensity\t' ||
+  { echo "ci_examples: light_intensity installed with GTRACK_PLUGIN_INSTALL_DIR is not found"; exit 1; }
 paths=(--plugin-path "$work/light_stimulus" --plugin-path "$work/three_finger_gripper" --plugin-path "$work/telecentric_sensor")
 listing=$(env -u GTRACK_PLUGIN_PATH "$gtrack" plugins "${paths[@]}")
 echo "$listing"
