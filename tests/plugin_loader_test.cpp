@@ -8,6 +8,7 @@
 #include <map>
 #include <gtrack/error.hpp>
 #include <gtrack/plugin_loader.hpp>
+#include <gtrack/setup.hpp>
 
 namespace fs = std::filesystem;
 
@@ -146,6 +147,28 @@ TEST(PluginLoader, DiscoverySkipsALibraryNamedOtherwise) {
   for (const auto& r : loader.discover()) listed = listed || r.name == "fixture_good_sensor";
   EXPECT_TRUE(listed);
   fs::remove_all(dir);
+}
+
+// A sensor whose projection is not of its image's size (Projection::size
+// left unset) is refused when the setup is loaded, naming both sizes.
+TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {
+  gtrack::SetupOptions o;
+  o.plugin_paths = {kFixtures};
+  o.with_stimulus = false;
+  const std::string gripper = "[gripper]\nplugin = \"hydrogel_six_finger\"\n";
+  EXPECT_NO_THROW(gtrack::load_setup(
+      gtrack::ConfigTable::parse("[sensor]\nplugin = \"fixture_good_sensor\"\n" + gripper, "lab.toml"), o));
+  try {
+    gtrack::load_setup(gtrack::ConfigTable::parse(
+                           "[sensor]\nplugin = \"fixture_good_sensor\"\nprojection_size = 0\n" + gripper, "lab.toml"),
+                       o);
+    ADD_FAILURE() << "a projection of another size was taken";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.toml:2: key 'sensor.plugin': the sensor's projection().size is 0x0 "
+                                         "and its image_size() 64x64; expected the same positive size"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(PluginLoader, UnknownKeyInThePluginTable) {

@@ -49,6 +49,20 @@ void warn_on_scale_mismatch(const ConfigTable& root, const Sensor& sensor, const
                 root.source(), 2 * model.radius_mm(), across_px, mm_per_px, size.width, size.height);
 }
 
+// The renderers draw at projection().size and the frames come at
+// image_size(): a sensor plugin whose two differ (its projection's size left
+// unset) would render nothing the frames show.
+void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
+  const ImageSize image = sensor.image_size();
+  const ImageSize drawn = sensor.projection().size;
+  if (image.width <= 0 || image.height <= 0 || drawn.width != image.width || drawn.height != image.height) {
+    table.fail("plugin", "the sensor's projection().size is " + std::to_string(drawn.width) + "x" +
+                             std::to_string(drawn.height) + " and its image_size() " + std::to_string(image.width) +
+                             "x" + std::to_string(image.height) + "; expected the same positive size (a plugin "
+                             "sets Projection::size to its image size)");
+  }
+}
+
 }  // namespace
 
 Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
@@ -69,6 +83,7 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
     }
   }
   s.sensor = loader->make_sensor(root.table("sensor"));
+  check_projection_size(root.table("sensor"), *s.sensor);
   s.gripper = loader->make_gripper(root.table("gripper"));
   warn_on_scale_mismatch(root, *s.sensor, s.model());
   if (options.with_stimulus) {
