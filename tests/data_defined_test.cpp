@@ -172,6 +172,20 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   std::string far = kFourFinger;
   far.replace(far.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.2, 500]");
   EXPECT_NE(config_error(far).find("finger[0].base_mm"), std::string::npos) << config_error(far);
+  // A hinge off the palm's outline (a finger floating beside it, or one from
+  // the palm's middle) is refused, naming the finger.
+  const std::string floating = with(kFourFinger, "base_mm = [-0.2, 0.2]", "base_mm = [-0.5, 0.4]");
+  EXPECT_NE(config_error(floating).find("key 'finger[1].base_mm': [-0.5, 0.4] is 0.354 mm off the palm's outline; "
+                                        "expected a point on it"),
+            std::string::npos)
+      << config_error(floating);
+  EXPECT_NE(config_error(with(kFourFinger, "base_mm = [0.2, 0.2]", "base_mm = [0, 0]")).find("finger[0].base_mm"),
+            std::string::npos);
+  // A misspelt [[finger]] leaves a finger out, which breaks the symmetry:
+  // the misspelling is what is named.
+  std::string misspelt = kFourFinger;
+  misspelt.replace(misspelt.rfind("[[finger]]"), 10, "[[fingers]]");
+  EXPECT_NE(config_error(misspelt).find("key 'fingers': unknown key"), std::string::npos) << config_error(misspelt);
   // Links each within the bound that together reach past it from the palm.
   std::string reach = kFourFinger;
   for (size_t at; (at = reach.find("link_lengths_mm = [0.3, 0.3]")) != std::string::npos;) {
@@ -195,7 +209,9 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
             std::string::npos)
       << e;
   EXPECT_EQ(config_error(with(two, "symmetry_order = 4", "symmetry_order = 2")), "");
-  const std::string oblong = with(kFourFinger, "[[0.4, 0.0], [0.0, 0.4]", "[[0.6, 0.0], [0.0, 0.4]");
+  std::string oblong = with(with(kFourFinger, "[[0.4, 0.0], [0.0, 0.4]", "[[0.6, 0.0], [0.0, 0.4]"),
+                                  "base_mm = [0.2, 0.2]", "base_mm = [0.3, 0.2]");
+  oblong = with(oblong, "base_mm = [0.2, -0.2]", "base_mm = [0.3, -0.2]");
   EXPECT_NE(config_error(oblong).find("takes palm point 1 [0.6, 0] to [0, 0.6], 0.2 mm off the palm's outline"),
             std::string::npos)
       << config_error(oblong);

@@ -16,6 +16,8 @@
 #include <cmath>
 #include <filesystem>
 #include <gtrack/error.hpp>
+#include <cstdio>
+#include <limits>
 #include <gtrack/plugin.hpp>
 
 namespace {
@@ -37,6 +39,17 @@ std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
     links.push_back({lengths[j], widths[j], widths[j + 1]});
   }
   return links;
+}
+
+// The distance from `p` to the nearest side of the polygon `outline`.
+double distance_to_outline(const std::vector<Eigen::Vector2d>& outline, const Eigen::Vector2d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Eigen::Vector2d a = outline[i], ab = outline[(i + 1) % outline.size()] - a;
+    const double s = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    best = std::min(best, (a + s * ab - p).norm());
+  }
+  return best;
 }
 
 gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
@@ -69,10 +82,21 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
                            (t.path().empty() ? std::string("top-level") : "[" + t.path() + "]") +
                            " keys (or use [radial])");
     }
+    double palm_radius = 0;
+    for (const auto& p : g.palm_mm) palm_radius = std::max(palm_radius, p.norm());
     for (const auto& f : fingers) {
       gtrack::FingerShape F;
       auto b = f.numbers("base_mm", 2, kPlace);
       F.base_mm = {b[0], b[1]};
+      // The first hinge sits on the palm's outline; a finger elsewhere is
+      // drawn floating, or out of the palm's middle, without a word.
+      const double off = distance_to_outline(g.palm_mm, F.base_mm);
+      if (off > 0.05 * palm_radius) {
+        char text[160];
+        std::snprintf(text, sizeof text, "[%g, %g] is %.3g mm off the palm's outline; expected a point on it",
+                      b[0], b[1], off);
+        f.fail("base_mm", text);
+      }
       F.direction_deg = f.number("direction_deg", Range::closed(-360, 360));
       F.links = read_links(f);
       f.check_all_used();
@@ -105,12 +129,17 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", 1e9, Range::positive());
   // Default: what the geometry has already; a radial gripper is symmetric
   // under a turn by one finger, one drawn finger by finger is not.
-  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", g.symmetry_order, Range{1, 64}));
-  if (const std::string broken = gtrack::symmetry_mismatch(g); !broken.empty()) t.fail("symmetry_order", broken);
   // Both are joint values the tracker starts from: within the limits.
   const Range limits = Range::closed(g.joint_min_deg, g.joint_max_deg);
   g.unfolded_deg = t.number_or("unfolded_deg", std::clamp(0.0, g.joint_min_deg, g.joint_max_deg), limits);
   g.folded_deg = t.number_or("folded_deg", std::clamp(60.0, g.joint_min_deg, g.joint_max_deg), limits);
+  g.symmetry_order = static_cast<int>(t.integer_or("symmetry_order", g.symmetry_order, Range{1, 64}));
+  if (const std::string broken = gtrack::symmetry_mismatch(g); !broken.empty()) {
+    // A misspelt [[finger]] leaves a finger out, which breaks the symmetry:
+    // the unknown key is the cause to name.
+    t.check_all_used();
+    t.fail("symmetry_order", broken);
+  }
   return g;
 }
 
