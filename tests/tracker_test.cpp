@@ -135,6 +135,26 @@ TEST(Tracker, CoarseSearchFindsTheGripperOnTheFirstFrame) {
   EXPECT_GT(e.evaluations, 800u);
 }
 
+// A blob of the gripper's colour apart from it (a reflector, a caliper mark)
+// pulls the centroid of O off the gripper: the coarse search also starts
+// from the largest blob, and finds the gripper.
+TEST(Tracker, CoarseSearchFindsTheGripperBesideABlobOfItsColour) {
+  // The gripper ~32 px across in a 256 px image, the search box all of it.
+  std::string config = kConfig;
+  config.replace(config.find("fx = 3200.0"), 11, "fx = 800.0");
+  config.replace(config.find("[-3.0, -3.0, 98.0]"), 18, "[-15.0, -15.0, 98.0]");
+  config.replace(config.find("[3.0, 3.0, 102.0]"), 17, "[15.0, 15.0, 102.0]");
+  auto setup = gtrack::load_setup(gtrack::ConfigTable::parse(config, "<test>"), {});
+  const auto engine = gtrack::engine_config(setup);
+  gtrack::Tracker tracker(setup, engine);
+  const Eigen::VectorXd truth = pose(-6, -6, 25, 15);
+  cv::Mat image = scene(setup, truth, 1);
+  cv::circle(image, {224, 224}, 8, cv::Scalar(60, 70, 200), cv::FILLED);  // 12 mm, 12 mm
+  const auto e = tracker.process(image, 0, 0.0, 22.0);
+  EXPECT_EQ(e.status, gtrack::TrackStatus::Search);
+  EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.3) << e.hypothesis.transpose();
+}
+
 // A gripper moving three times the swarm's x spread per frame: frame 1 is
 // found again by re-detection, and the step between the two found estimates
 // starts particle 1 of frame 2, which then follows without re-detection.

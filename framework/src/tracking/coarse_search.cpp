@@ -1,5 +1,6 @@
-// Grid of hypotheses at the observation's centroid, each also tried with its own
-// outline centred there; then a PSO per candidate.
+// Grid of hypotheses at the observation's centroid (and at its largest blob's,
+// when that is apart), each also tried with its own outline centred there;
+// then a PSO per candidate.
 #include "coarse_search.hpp"
 
 #include <Eigen/Dense>
@@ -113,6 +114,19 @@ Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen:
   return near + a.transpose() * aat.ldlt().solve(r);
 }
 
+// The centroid (pixel centres at +0.5) of the largest 8-connected blob of a
+// mask that holds more than one; nullopt for one blob or none.
+std::optional<Eigen::Vector2d> largest_blob_centre(const cv::Mat& mask) {
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  if (n <= 2) return std::nullopt;  // the background and at most one blob
+  int best = 1;
+  for (int i = 2; i < n; ++i) {
+    if (stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = i;
+  }
+  return Eigen::Vector2d(centroids.at<double>(best, 0) + 0.5, centroids.at<double>(best, 1) + 0.5);
+}
+
 CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig& config, CostEvaluator& cost,
                                  std::mt19937_64& rng) {
   CoarseSearchResult result;
@@ -127,10 +141,6 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
   // check then refines the other branch.
   ParameterSpace space = config.space;
   space.lower.tail(dims - kPoseDims).array() -= kBackwardFoldDeg;
-  const cv::Moments mo = cv::moments(*in.observation, true);
-  const double u = mo.m00 > 0 ? mo.m10 / mo.m00 + 0.5 : in.observation->cols * 0.5;
-  const double v = mo.m00 > 0 ? mo.m01 / mo.m00 + 0.5 : in.observation->rows * 0.5;
-  const Eigen::Vector3d centre = lift_pixel(in.render_projection, u, v, in.nominal_mm);
 
   const TrackerConfig& tc = config.tracker;
   const double period = 360.0 / std::max(1, model.geometry().symmetry_order);
@@ -165,78 +175,108 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
   std::vector<double> joints;
   for (int j = 0; j < 4; ++j) joints.push_back(in.joint_lo + (in.joint_hi - in.joint_lo) * j / 3.0);
 
-  Eigen::MatrixXd grid(dims, static_cast<Eigen::Index>(rotations.size() * joints.size()));
-  int col = 0;
-  for (const Eigen::Vector3d& rotation : rotations) {
-    for (double q : joints) {
-      Eigen::VectorXd h(dims);
-      h.head<3>() = centre;
-      h.segment<3>(3) = rotation;
-      h.tail(dims - kPoseDims).setConstant(q);
-      space.clamp(h);
-      grid.col(col++) = h;
-    }
-  }
-  Eigen::VectorXd scores;
-  cost.evaluate(grid, scores);
-  result.evaluations += static_cast<std::uint64_t>(grid.cols());
-
-  // The palm centre is not the outline's centroid: a tilted, folded
-  // gripper's outline lies to one side of it, by up to a third of its size.
-  // Every grid point is also tried moved so that its outline's centroid
-  // falls on the observed one (one more batch), and keeps the better place.
-  if (mo.m00 > 0) {
-    const render::Frustum image = image_frustum(in.render_projection);
-    Eigen::MatrixXd centred = grid;
-    OutlineScratch scratch;
-    for (Eigen::Index i = 0; i < grid.cols(); ++i) {
-      // Where the outline crosses the image's border, moving it changes its
-      // visible part: then a second pass.
-      for (int pass = 0; pass < 2; ++pass) {
-        auto h = centred.col(i);
-        const auto c = outline_centroid(model, in.render_projection, image, h, scratch);
-        if (!c) break;
-        const Eigen::Vector2d shift = Eigen::Vector2d(u, v) - *c;
-        if (shift.norm() < 0.25) break;
-        const Eigen::Vector2d target =
-            render::dehomogenise(render::project(in.render_projection, h.head<3>())) + shift;
-        h.head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
+  // The grid around the observed pixel (u, v), each point at its best place
+  // (below), with the cost of each.
+  const bool observed = cv::countNonZero(*in.observation) > 0;
+  const auto grid_at = [&](double u, double v) {
+    Eigen::MatrixXd grid(dims, static_cast<Eigen::Index>(rotations.size() * joints.size()));
+    const Eigen::Vector3d centre = lift_pixel(in.render_projection, u, v, in.nominal_mm);
+    int col = 0;
+    for (const Eigen::Vector3d& rotation : rotations) {
+      for (double q : joints) {
+        Eigen::VectorXd h(dims);
+        h.head<3>() = centre;
+        h.segment<3>(3) = rotation;
+        h.tail(dims - kPoseDims).setConstant(q);
         space.clamp(h);
-        if (!scratch.cut) break;
+        grid.col(col++) = h;
       }
     }
-    keep_better_places(grid, scores, centred, 1, cost, result.evaluations);
+    Eigen::VectorXd scores;
+    cost.evaluate(grid, scores);
+    result.evaluations += static_cast<std::uint64_t>(grid.cols());
 
-    // Coming into view (or leaving it), the gripper shows a sliver: the
-    // centred grid point, which shows about half of its outline, covers far
-    // more than O. Where O touches the image's border, each grid point is
-    // also tried moved out across it by 1..n steps of 0.3 model radii, and
-    // centred again along the border only (one more batch of n per point);
-    // each point keeps its best place.
-    const int steps = tc.coarse_border_steps;
-    const Eigen::Vector2d outward = steps > 0 ? border_outward(*in.observation) : Eigen::Vector2d::Zero();
-    if (outward.norm() > 0) {
-      const Eigen::Vector2d along(-outward.y(), outward.x());
-      const Eigen::Vector2d c0 = render::dehomogenise(render::project(in.render_projection, centre));
-      const Eigen::Vector2d c1 = render::dehomogenise(
-          render::project(in.render_projection, centre + Eigen::Vector3d(model.radius_mm(), 0, 0)));
-      const double step = kBorderStepRadii * (c1 - c0).norm();
-      Eigen::MatrixXd moved(dims, grid.cols() * steps);
+    // The palm centre is not the outline's centroid: a tilted, folded
+    // gripper's outline lies to one side of it, by up to a third of its size.
+    // Every grid point is also tried moved so that its outline's centroid
+    // falls on the observed one (one more batch), and keeps the better place.
+    if (observed) {
+      const render::Frustum image = image_frustum(in.render_projection);
+      Eigen::MatrixXd centred = grid;
+      OutlineScratch scratch;
       for (Eigen::Index i = 0; i < grid.cols(); ++i) {
-        for (int k = 0; k < steps; ++k) {
-          Eigen::VectorXd h = grid.col(i);
-          Eigen::Vector2d p =
-              render::dehomogenise(render::project(in.render_projection, h.head<3>())) + outward * step * (k + 1);
-          h.head<3>() = lift_pixel(in.render_projection, p[0], p[1], h.head<3>());
-          if (const auto c = outline_centroid(model, in.render_projection, image, h, scratch)) {
-            p += along * (Eigen::Vector2d(u, v) - *c).dot(along);
-            h.head<3>() = lift_pixel(in.render_projection, p[0], p[1], h.head<3>());
-          }
+        // Where the outline crosses the image's border, moving it changes its
+        // visible part: then a second pass.
+        for (int pass = 0; pass < 2; ++pass) {
+          auto h = centred.col(i);
+          const auto c = outline_centroid(model, in.render_projection, image, h, scratch);
+          if (!c) break;
+          const Eigen::Vector2d shift = Eigen::Vector2d(u, v) - *c;
+          if (shift.norm() < 0.25) break;
+          const Eigen::Vector2d target =
+              render::dehomogenise(render::project(in.render_projection, h.head<3>())) + shift;
+          h.head<3>() = lift_pixel(in.render_projection, target[0], target[1], centre);
           space.clamp(h);
-          moved.col(i * steps + k) = h;
+          if (!scratch.cut) break;
         }
       }
-      keep_better_places(grid, scores, moved, steps, cost, result.evaluations);
+      keep_better_places(grid, scores, centred, 1, cost, result.evaluations);
+
+      // Coming into view (or leaving it), the gripper shows a sliver: the
+      // centred grid point, which shows about half of its outline, covers far
+      // more than O. Where O touches the image's border, each grid point is
+      // also tried moved out across it by 1..n steps of 0.3 model radii, and
+      // centred again along the border only (one more batch of n per point);
+      // each point keeps its best place.
+      const int steps = tc.coarse_border_steps;
+      const Eigen::Vector2d outward = steps > 0 ? border_outward(*in.observation) : Eigen::Vector2d::Zero();
+      if (outward.norm() > 0) {
+        const Eigen::Vector2d along(-outward.y(), outward.x());
+        const Eigen::Vector2d c0 = render::dehomogenise(render::project(in.render_projection, centre));
+        const Eigen::Vector2d c1 = render::dehomogenise(
+            render::project(in.render_projection, centre + Eigen::Vector3d(model.radius_mm(), 0, 0)));
+        const double step = kBorderStepRadii * (c1 - c0).norm();
+        Eigen::MatrixXd moved(dims, grid.cols() * steps);
+        for (Eigen::Index i = 0; i < grid.cols(); ++i) {
+          for (int k = 0; k < steps; ++k) {
+            Eigen::VectorXd h = grid.col(i);
+            Eigen::Vector2d p =
+                render::dehomogenise(render::project(in.render_projection, h.head<3>())) + outward * step * (k + 1);
+            h.head<3>() = lift_pixel(in.render_projection, p[0], p[1], h.head<3>());
+            if (const auto c = outline_centroid(model, in.render_projection, image, h, scratch)) {
+              p += along * (Eigen::Vector2d(u, v) - *c).dot(along);
+              h.head<3>() = lift_pixel(in.render_projection, p[0], p[1], h.head<3>());
+            }
+            space.clamp(h);
+            moved.col(i * steps + k) = h;
+          }
+        }
+        keep_better_places(grid, scores, moved, steps, cost, result.evaluations);
+      }
+    }
+
+    return std::make_pair(grid, scores);
+  };
+  // Around the centroid of O; and, when O holds apart a blob of its own
+  // (the gripper beside a bright reflector, a caliper mark or clutter that
+  // passes the bounds), around the largest blob too: the centroid of all
+  // of them can lie on none.
+  const cv::Moments mo = cv::moments(*in.observation, true);
+  const double u = observed ? mo.m10 / mo.m00 + 0.5 : in.observation->cols * 0.5;
+  const double v = observed ? mo.m01 / mo.m00 + 0.5 : in.observation->rows * 0.5;
+  auto [grid, scores] = grid_at(u, v);
+  if (const auto blob = largest_blob_centre(*in.observation)) {
+    const Eigen::Vector3d centre = lift_pixel(in.render_projection, u, v, in.nominal_mm);
+    const double radius_px =
+        (render::dehomogenise(render::project(in.render_projection, centre + Eigen::Vector3d(model.radius_mm(), 0, 0))) -
+         render::dehomogenise(render::project(in.render_projection, centre)))
+            .norm();
+    if ((*blob - Eigen::Vector2d(u, v)).norm() > radius_px) {
+      auto [more, more_scores] = grid_at(blob->x(), blob->y());
+      grid.conservativeResize(Eigen::NoChange, grid.cols() + more.cols());
+      grid.rightCols(more.cols()) = more;
+      scores.conservativeResize(scores.size() + more_scores.size());
+      scores.tail(more_scores.size()) = more_scores;
     }
   }
 
