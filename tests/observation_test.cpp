@@ -79,6 +79,24 @@ TEST(Observation, RoiAndPriorDropFarPixels) {
   EXPECT_EQ(prior_only.detected, all.count);
 }
 
+// Rectangles the recording burns in (a scale bar, a scanner's text) are
+// never observed, whatever their colour; the rest is as before.
+TEST(Observation, ExcludedRectanglesAreNeverObserved) {
+  cv::Mat img = grey_frame();
+  cv::circle(img, {60, 60}, 20, cv::Scalar(40, 40, 200), cv::FILLED);
+  cv::rectangle(img, cv::Rect(150, 180, 40, 12), cv::Scalar(40, 40, 200), cv::FILLED);  // a red scale bar
+  gtrack::ObservationConfig c;
+  gtrack::Segmenter all(c, {200, 200}, {50, 50});
+  EXPECT_EQ(all.segment(img).at<uchar>(185, 170), 255);
+  c.exclude_px = {cv::Rect(145, 175, 55, 25)};
+  gtrack::Segmenter seg(c, {200, 200}, {50, 50});
+  const cv::Mat full = seg.segment(img);
+  EXPECT_EQ(cv::countNonZero(full(cv::Rect(145, 175, 55, 25))), 0);
+  cv::Mat expected = all.segment(img);
+  expected(cv::Rect(145, 175, 55, 25)).setTo(0);
+  EXPECT_EQ(cv::countNonZero(full != expected), 0);
+}
+
 TEST(Observation, NothingDetectedIsEmpty) {
   gtrack::Segmenter seg(gtrack::ObservationConfig{}, {200, 200}, {50, 50});
   EXPECT_TRUE(seg.observe(grey_frame()).empty());

@@ -983,6 +983,24 @@ TEST(Tracker, UnseenFingersTakeTheSeenFingersFold) {
   }
 }
 
+// [observation] exclude_px: rectangles of whole pixels within the image.
+TEST(EngineConfig, ExcludedRectanglesAreWholePixelsWithinTheImage) {
+  auto setup = make_setup("[observation]\nexclude_px = [[0, 240, 60, 16], [200, 0, 56, 20]]\n");
+  const auto c = gtrack::engine_config(setup);
+  ASSERT_EQ(c.observation.exclude_px.size(), 2u);
+  EXPECT_EQ(c.observation.exclude_px[0], cv::Rect(0, 240, 60, 16));
+  EXPECT_TRUE(gtrack::engine_config(make_setup()).observation.exclude_px.empty());
+  for (const char* bad : {"[[0, 250, 60, 16]]", "[[0, 0, 0, 5]]", "[[1.5, 0, 4, 4]]", "[[0, 0, 4]]"}) {
+    const std::string m = engine_config_error(std::string("[observation]\nexclude_px = ") + bad + "\n");
+    EXPECT_NE(m.find("<test>:"), std::string::npos) << m;
+    EXPECT_NE(m.find("exclude_px"), std::string::npos) << m;
+  }
+  EXPECT_NE(engine_config_error("[observation]\nexclude_px = [[0, 250, 60, 16]]\n")
+                .find("expected [x, y, width, height] in whole pixels, width and height at least 1, within the "
+                      "256x256 image"),
+            std::string::npos);
+}
+
 TEST(EngineConfig, PaperDefaults) {
   auto setup = make_setup();
   const auto c = gtrack::engine_config(setup);

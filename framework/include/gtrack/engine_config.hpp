@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,10 @@ struct ObservationConfig {
   bool prior = true;                // drop pixels unlikely given the previous model
   double prior_sigma_px = 24;       // full-resolution pixels
   double prior_threshold = 0.05;    // keep p(O_t+1 | P_t) = exp(-d^2 / 2 sigma^2) above this
+  // Full-resolution rectangles never observed: what the recording burns
+  // into every frame (a scale bar, a time stamp, a scanner's text, ruler
+  // and caliper marks).
+  std::vector<cv::Rect> exclude_px;
 };
 
 struct PsoConfig {

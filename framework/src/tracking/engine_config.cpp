@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fmt/format.h>
 #include <limits>
 
 #include "gtrack/error.hpp"
@@ -40,6 +41,19 @@ ObservationConfig read_observation(const ConfigTable& t, const Sensor& sensor) {
   if (o.saturation_min > o.saturation_max) t.fail("saturation_min", "must not exceed saturation_max");
   if (o.value_min > o.value_max) t.fail("value_min", "must not exceed value_max");
   if (o.luminance_min > o.luminance_max) t.fail("luminance_min", "must not exceed luminance_max");
+  const ImageSize size = sensor.image_size();
+  const auto rectangles = t.has("exclude_px") ? t.number_rows("exclude_px", 4, Range::closed(0, 65536))
+                                               : std::vector<std::vector<double>>{};
+  for (const auto& r : rectangles) {
+    if (r[0] != std::floor(r[0]) || r[1] != std::floor(r[1]) || r[2] != std::floor(r[2]) || r[3] != std::floor(r[3]) ||
+        r[2] < 1 || r[3] < 1 || r[0] + r[2] > size.width || r[1] + r[3] > size.height) {
+      t.fail("exclude_px", fmt::format("[{:g}, {:g}, {:g}, {:g}]: expected [x, y, width, height] in whole pixels, "
+                                       "width and height at least 1, within the {}x{} image",
+                                       r[0], r[1], r[2], r[3], size.width, size.height));
+    }
+    o.exclude_px.emplace_back(static_cast<int>(r[0]), static_cast<int>(r[1]), static_cast<int>(r[2]),
+                              static_cast<int>(r[3]));
+  }
   return o;
 }
 

@@ -56,6 +56,7 @@ cv::Mat Segmenter::segment(const cv::Mat& frame, std::optional<cv::Rect> roi) co
     cv::morphologyEx(part, part, cv::MORPH_OPEN, k);
   }
   part.copyTo(mask(area));
+  for (const cv::Rect& r : c.exclude_px) mask(r & full).setTo(0);
   return mask;
 }
 
