@@ -207,7 +207,8 @@ TEST(Fault, NoFaultTracksEveryFrame) {
 }
 
 // A video cut short (a recording interrupted, a partial copy): the frames
-// that decode are tracked, the run ends normally with them.
+// that decode are tracked, the run ends normally with them. A frame rate
+// in the config over the video's own is said.
 TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
   const fs::path dir = fresh_dir("truncated_video");
   const fs::path avi = dir / "clip.avi";
@@ -257,6 +258,15 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
   EXPECT_EQ(whole.frames, 6);
   EXPECT_EQ(whole.input_ended_early, "");
   EXPECT_NE(read_text(o.out_dir / "summary.json").find("\"input_ended_early\": null"), std::string::npos);
+  // A config's frame rate set over the video's own is said.
+  TrackRun at_30 = make_run();
+  at_30.config.tracker.fps = 30;
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  gtrack::track_sequence(at_30.setup, at_30.config, o);
+  gtrack::logger().sinks().pop_back();
+  EXPECT_NE(log.str().find("clip.avi: the video says 10 frames/s, [tracker] fps = 30 is taken"), std::string::npos)
+      << log.str();
 }
 
 // Grey images for a segmentation by colour: every frame would be lost

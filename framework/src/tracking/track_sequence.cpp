@@ -331,6 +331,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                                   FollowOptions{options.follow_input_s, options.cancel});
   source->set_image_bits(config.tracker.image_bits);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
+  if (config.tracker.fps > 0 && source->fps() > 0 && std::abs(source->fps() / config.tracker.fps - 1) > 0.01) {
+    // A video's own rate set aside: its frame times, a time_s log and the
+    // stimulus's response run on the config's.
+    logger().warn("{}: the video says {:g} frames/s, [tracker] fps = {:g} is taken; its frame times, a time_s "
+                  "stimulus log and the material's response run on {:g} (remove fps to take the video's)",
+                  options.input, source->fps(), config.tracker.fps, config.tracker.fps);
+  }
   if (!resumed && expected_frames(*source, range) == 0) {
     throw InputError(options.input + ": holds " + std::to_string(source->frame_count()) +
                      " frames, none of them in --frames " + std::to_string(range.first) + ":" +
