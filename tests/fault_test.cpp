@@ -337,12 +337,12 @@ TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
     cv::imwrite((dir / "bright_field" / ("00000" + std::to_string(i) + ".png")).string(), inverted);
   }
   const std::string bright_log = warnings_of(dir / "bright_field", dir / "out_bright");
-  EXPECT_NE(bright_log.find("% of the image is within the [observation] bounds (luminance 128 to 255): they take "
-                            "the background for the gripper"),
+  EXPECT_NE(bright_log.find("times the gripper's outline, is within the [observation] bounds (luminance 128 to "
+                            "255): they take the background for the gripper"),
             std::string::npos)
       << bright_log;
   EXPECT_NE(bright_log.find("needs luminance_min = 0"), std::string::npos) << bright_log;
-  EXPECT_EQ(warnings_of(plain, dir / "out_dark_field").find("of the image is within"), std::string::npos);
+  EXPECT_EQ(warnings_of(plain, dir / "out_dark_field").find("is within the [observation] bounds"), std::string::npos);
 }
 
 // A folder whose image becomes unreadable part way: the run stops at that

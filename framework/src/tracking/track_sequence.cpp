@@ -169,9 +169,10 @@ PoseTable read_gripper_poses(const fs::path& file, const Setup& setup, bool trut
 //   one value throughout (the lamp off, a blank frame) says nothing of the
 //   recording and is passed over;
 // - the first frame that observes nothing, while none before it did;
-// - a first frame whose observation covers most of the image: the bounds
-//   take the background for the gripper (a bright-field recording, a dark
-//   gripper on a light background, segmented for bright pixels).
+// - a first frame whose observation covers most of the image, or ten times
+//   the estimate's outline: the bounds take the background for the gripper
+//   (a bright-field recording segmented for bright pixels, an ultrasound
+//   gain raised above the bounds).
 class ObservationAdvice {
  public:
   explicit ObservationAdvice(const ObservationConfig& o) : o_(o) {}
@@ -186,13 +187,15 @@ class ObservationAdvice {
     }
     seen_any_ = seen_any_ || e.observed_pixels > 0;
     const double share = observation.mask.empty() ? 0.0 : double(e.observed_pixels) / observation.mask.total();
-    if (first && share > 0.5) {
-      logger().warn("{}: {:.0f} % of the image is within the [observation] bounds ({}): they take the background "
-                    "for the gripper, and the track follows it; {} (check with --save-masks)",
-                    frame.name, 100 * share, bounds(),
+    const double times_model = e.terms.rendered > 0 ? double(e.observed_pixels) / e.terms.rendered : 0.0;
+    if (first && (share > 0.5 || times_model > 10)) {
+      logger().warn("{}: {:.0f} % of the image, {:.0f} times the gripper's outline, is within the [observation] "
+                    "bounds ({}): they take the background for the gripper, and the track follows it; {} (check "
+                    "with --save-masks)",
+                    frame.name, 100 * share, times_model, bounds(),
                     o_.color_space == "luminance"
-                        ? "a dark gripper on a light background needs luminance_min = 0 and luminance_max below "
-                          "the background's"
+                        ? "raise luminance_min above the background's brightness (a dark gripper on a light "
+                          "background needs luminance_min = 0 and luminance_max below the background's)"
                         : "narrow them to the gripper's colour");
     }
   }
