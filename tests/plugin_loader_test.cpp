@@ -93,6 +93,7 @@ TEST(PluginLoader, WrongKind) {
   gtrack::PluginLoader loader({kFixtures});
   std::string e = plugin_error([&] { loader.make_gripper(table("fixture_wrong_kind", "gripper")); });
   EXPECT_NE(e.find("is a sensor plugin; [gripper] needs a gripper plugin"), std::string::npos) << e;
+  EXPECT_EQ(e.rfind("t.toml:2: key 'gripper.plugin': ", 0), 0u) << "starts where the config names it: " << e;
 }
 
 TEST(PluginLoader, FactoryThrowsGivesItsMessage) {

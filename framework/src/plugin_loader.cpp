@@ -304,14 +304,13 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
     table.fail("plugin", "expected a plugin name (letters, digits, '_' and '-', 1 to 64 characters), got a string of " +
                              std::to_string(name.size()) + " characters");
   }
-  fs::path file;
+  // Where the config names the plugin, ahead of what is wrong with it (not
+  // found, not loadable, another kind or ABI, its factory failed).
   try {
-    file = find(kind, name);
+    return make_from_file<Interface>(find(kind, name), name, table);
   } catch (const PluginError& e) {
-    // Where the config names the plugin, ahead of what is wrong with it.
     throw PluginError(table.where("plugin") + ": " + e.what());
   }
-  return make_from_file<Interface>(file, name, table);
 }
 
 std::shared_ptr<Sensor> PluginLoader::make_sensor(const ConfigTable& t) const { return make<Sensor>(t); }
