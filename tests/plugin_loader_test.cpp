@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <spdlog/sinks/ostream_sink.h>
+#include <sstream>
 #include <gtrack/error.hpp>
+#include <gtrack/log.hpp>
 #include <gtrack/plugin_loader.hpp>
 #include <gtrack/setup.hpp>
 
@@ -209,6 +212,31 @@ TEST(PluginLoader, SearchOrderPutsUserPathsFirst) {
   EXPECT_EQ(p[2], "/env/a");
   EXPECT_EQ(p[3], "/env/b");
   EXPECT_EQ(p[4], gtrack::default_plugin_dir());
+}
+
+// A plugin found in an earlier folder is taken over one of the same name in
+// a later one (a built-in), which is said once, and listed once.
+TEST(PluginLoader, APluginThatSetsAnotherAsideIsSaidOnce) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_shadowing_plugins";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(kFixtures / "libgtrack_fixture_good_sensor.so", dir / "libgtrack_fixture_good_sensor.so");
+  gtrack::PluginLoader loader({dir, kFixtures});
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  loader.make_sensor(table("fixture_good_sensor"));
+  loader.make_sensor(table("fixture_good_sensor"));
+  int listed = 0;
+  for (const auto& r : loader.discover()) listed += r.name == "fixture_good_sensor";
+  gtrack::logger().sinks().pop_back();
+  const std::string said = "sensor plugin 'fixture_good_sensor' taken from " +
+                           (dir / "libgtrack_fixture_good_sensor.so").string() + ", ahead of the one in " +
+                           kFixtures.string();
+  EXPECT_NE(log.str().find(said), std::string::npos) << log.str();
+  EXPECT_EQ(log.str().find(said), log.str().rfind(said)) << "said once: " << log.str();
+  EXPECT_EQ(listed, 1);
+  EXPECT_NE(log.str().find("not listed: the one in an earlier folder is taken"), std::string::npos) << log.str();
+  fs::remove_all(dir);
 }
 
 }  // namespace

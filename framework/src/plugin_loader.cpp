@@ -209,7 +209,11 @@ std::vector<PluginRecord> PluginLoader::discover() const {
           continue;
         }
         std::string key = std::string(to_string(r.kind)) + "/" + r.name;
-        if (seen[key]) continue;
+        if (seen[key]) {
+          logger().info("{}: {} plugin '{}' not listed: the one in an earlier folder is taken", f.string(),
+                        to_string(r.kind), r.name);
+          continue;
+        }
         seen[key] = true;
         out.push_back(std::move(r));
       } catch (const PluginError& e) {
@@ -229,10 +233,25 @@ fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
     throw PluginError(std::string(to_string(kind)) + " plugin name '" + name +
                       "': expected letters, digits, '_', '-' or '.' (a name, not a path; use plugin_path for folders)");
   }
-  for (const auto& dir : paths_) {
-    fs::path f = dir / library_file_name(name);
+  for (auto dir = paths_.begin(); dir != paths_.end(); ++dir) {
+    fs::path f = *dir / library_file_name(name);
     std::error_code ec;
-    if (fs::exists(f, ec)) return f;
+    if (!fs::exists(f, ec)) continue;
+    // A plugin of the same name further down the search path (a built-in
+    // one, say) is set aside: said, since the run then differs from one
+    // without the folder.
+    for (auto later = std::next(dir); later != paths_.end(); ++later) {
+      if (!fs::exists(*later / library_file_name(name), ec)) continue;
+      static std::mutex mutex;
+      static std::set<fs::path> said;  // once a file: a replayed stimulus is made again each frame
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (said.insert(f).second) {
+        logger().info("{} plugin '{}' taken from {}, ahead of the one in {}", to_string(kind), name, f.string(),
+                      later->string());
+      }
+      break;
+    }
+    return f;
   }
   std::string known;
   for (const auto& r : discover()) {
