@@ -9,6 +9,7 @@
 #include <optional>
 #include <opencv2/imgproc.hpp>
 
+#include "gtrack/log.hpp"
 #include "render/clip.hpp"
 
 namespace gtrack::detail {
@@ -272,6 +273,9 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
          render::dehomogenise(render::project(in.render_projection, centre)))
             .norm();
     if ((*blob - Eigen::Vector2d(u, v)).norm() > radius_px) {
+      logger().debug("coarse search: also from O's largest blob, at ({:.0f}, {:.0f}) render pixels, {:.0f} from O's "
+                     "centroid",
+                     blob->x(), blob->y(), (*blob - Eigen::Vector2d(u, v)).norm());
       auto [more, more_scores] = grid_at(blob->x(), blob->y());
       grid.conservativeResize(Eigen::NoChange, grid.cols() + more.cols());
       grid.rightCols(more.cols()) = more;
