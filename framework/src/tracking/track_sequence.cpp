@@ -277,7 +277,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     // is read, so that a reading the plugin refuses (a temperature in
     // kelvin) is an error naming its line, before a frame is tracked.
     StimulusLog::ReadingCheck check;
-    if (setup.loader) {
+    if (setup.loader && setup.stimulus) {
       check = [probe = setup.loader->make_stimulus(setup.root.table("stimulus")), row = 0](double value) mutable {
         probe->update(value, row++);
       };
