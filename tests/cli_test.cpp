@@ -46,6 +46,14 @@ fs::path write(const std::string& name, const std::string& text) {
   return p;
 }
 
+// `text` with the first `from` replaced by `to`.
+std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
+  std::string out = text;
+  const auto at = out.find(from);
+  if (at != std::string::npos) out.replace(at, from.size(), to);
+  return out;
+}
+
 // "track -c SEQ/sequence.toml -i SEQ/frames" for a folder 'gtrack synth' wrote.
 std::string track_of(const fs::path& seq) {
   return "track -c " + (seq / "sequence.toml").string() + " -i " + (seq / "frames").string();
@@ -220,11 +228,20 @@ TEST(Cli, TrackRefusesAReadingTheStimulusPluginCannotTake) {
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_NE(r.output.find((dir / "kelvin.csv").string() +
                             ":3: a reading of 295.15, outside the -50 to 150 C temperature_hysteresis takes: "
-                            "expected degrees Celsius (a log in kelvin: subtract 273.15)"),
+                            "expected degrees Celsius (kelvin: subtract 273.15)"),
               std::string::npos)
         << r.output;
     EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));
   }
+  // A default reading is checked as a log's rows are, naming its key.
+  std::ofstream(dir / "default.toml") << replaced(read_file(dir / "sequence.toml"), "[tracker]\n",
+                                                   "[tracker]\ndefault_stimulus = 300.0\n");
+  const CliRun d = gtrack("track -c " + (dir / "default.toml").string() + " -i " + (dir / "frames").string() +
+                          " -o " + (dir / "out").string());
+  EXPECT_EQ(d.code, 1) << d.output;
+  EXPECT_NE(d.output.find("key 'tracker.default_stimulus': a reading of 300, outside the -50 to 150 C"),
+            std::string::npos)
+      << d.output;
   // A log keyed by Unix time has no row near the recording's frames.
   std::ofstream(dir / "unix.csv") << "time_s,value\n1765011000.0,22\n1765011000.5,22.5\n";
   const CliRun r = gtrack(track_of(dir) + " -s " + (dir / "unix.csv").string() + " -o " + (dir / "out").string());
@@ -353,13 +370,6 @@ TEST(Cli, TrackIntoAnEarlierRunReplacesIt) {
   EXPECT_FALSE(fs::exists(dir / "out" / "overlay.avi"));
   EXPECT_EQ(count_files(dir / "out" / "masks", ".png"), 0);
   EXPECT_EQ(read_csv(dir / "out" / "estimates.csv").size(), 3u);  // header and frames 0, 1
-}
-
-std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
-  std::string out = text;
-  const auto at = out.find(from);
-  if (at != std::string::npos) out.replace(at, from.size(), to);
-  return out;
 }
 
 std::string hydrogel_config() {

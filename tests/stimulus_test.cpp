@@ -172,7 +172,7 @@ TEST(TemperatureHysteresis, RefusesAReadingThatIsNotCelsius) {
     s->update(296.15, 2);
     ADD_FAILURE() << "a reading in kelvin was taken";
   } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("expected degrees Celsius (a log in kelvin: subtract 273.15)"),
+    EXPECT_NE(std::string(e.what()).find("expected degrees Celsius (kelvin: subtract 273.15)"),
               std::string::npos)
         << e.what();
   }

@@ -209,11 +209,7 @@ std::vector<PluginRecord> PluginLoader::discover() const {
           continue;
         }
         std::string key = std::string(to_string(r.kind)) + "/" + r.name;
-        if (seen[key]) {
-          logger().info("{}: {} plugin '{}' not listed: the one in an earlier folder is taken", f.string(),
-                        to_string(r.kind), r.name);
-          continue;
-        }
+        if (seen[key]) continue;
         seen[key] = true;
         out.push_back(std::move(r));
       } catch (const PluginError& e) {
@@ -241,7 +237,8 @@ fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
     // one, say) is set aside: said, since the run then differs from one
     // without the folder.
     for (auto later = std::next(dir); later != paths_.end(); ++later) {
-      if (!fs::exists(*later / library_file_name(name), ec)) continue;
+      const fs::path other = *later / library_file_name(name);
+      if (!fs::exists(other, ec) || fs::equivalent(f, other, ec)) continue;  // none, or the same file again
       static std::mutex mutex;
       static std::set<fs::path> said;  // once a file: a replayed stimulus is made again each frame
       const std::lock_guard<std::mutex> lock(mutex);

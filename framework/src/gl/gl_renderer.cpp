@@ -181,8 +181,8 @@ void GlRenderer::release() noexcept {
   } catch (const std::exception& e) {
     // Current on the thread that used the renderer: the objects go with the
     // context, but only once that thread lets it go.
-    logger().warn("gl backend: a renderer destroyed on a thread other than the one that used it cannot delete "
-                  "its objects, whose memory is held while its context stays current there: {}",
+    logger().warn("gl backend: a renderer whose context cannot be made current here (destroyed on a thread "
+                  "other than the one that used it, or its context lost) cannot delete its objects: {}",
                   e.what());
     return;
   }

@@ -285,6 +285,14 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
                                   : StimulusLog::load(*options.stimulus_csv, std::move(check));
   }
+  // The reading every frame takes without a log, checked as a log's rows are.
+  if (!options.stimulus_csv && config.tracker.default_stimulus && setup.loader && setup.stimulus) {
+    try {
+      setup.loader->make_stimulus(setup.root.table("stimulus"))->update(*config.tracker.default_stimulus, 0);
+    } catch (const std::exception& e) {
+      throw ConfigError(setup.root.table("tracker").where("default_stimulus") + ": " + e.what());
+    }
+  }
   // Resuming: the saved state says which frame was done last; the source
   // starts at the next frame of the range.
   const fs::path state_file = options.out_dir / "tracker_state.txt";
@@ -504,6 +512,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
           std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
       results.write(e);
       if (options.durable) results.sync();  // the rows before the state that says they are done
+      if (options.on_frame) options.on_frame(e);
       if (options.save_masks) {
         char name[32];
         std::snprintf(name, sizeof name, "%06d.png", frame->index);
@@ -515,7 +524,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       state.run = run;
       write_tracker_state(state_file, state, options.durable);
       io_ms += seconds_since(t_write) * 1e3;
-      if (options.on_frame) options.on_frame(e);
 
       ++summary.frames;
       if (e.status == TrackStatus::Lost) ++summary.lost_frames;
@@ -536,9 +544,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       summary.stopped_by = e.what();
       finish();
       write_summary(options.out_dir / "summary.json", summary);
-      kept = fmt::format("; the {} frame{} before it {} kept in {} (--resume goes on once the cause is mended)",
-                         summary.frames, summary.frames == 1 ? "" : "s", summary.frames == 1 ? "is" : "are",
-                         options.out_dir.string());
+      const int done = summary.frames_before + summary.frames;
+      const bool resumable = !options.follow_stimulus && options.input.rfind("camera:", 0) != 0;
+      kept = fmt::format("; the {} frame{} before it {} kept in {}{}", done, done == 1 ? "" : "s",
+                         done == 1 ? "is" : "are", options.out_dir.string(),
+                         resumable ? " (--resume goes on once the cause is mended)" : "");
     } catch (const std::exception&) {
       // The error that stopped the run is the one to report.
     }

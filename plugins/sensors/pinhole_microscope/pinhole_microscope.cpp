@@ -154,16 +154,15 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     }
   }
   const auto dist = first_of({"distortion_coefficients", "dist_coeffs", "distCoeffs", "D"});
-  // Another entry that names a distortion would be dropped without a word,
-  // leaving the lens uncorrected.
-  for (const std::string& entry : in.root().keys()) {
+  // Without one of those, an entry that names a distortion otherwise would
+  // be dropped without a word, leaving the lens uncorrected. (Beside one,
+  // others are the calibration's own extras: dist_coeffs_std_dev.)
+  for (const std::string& entry : dist.first.empty() ? in.root().keys() : std::vector<std::string>{}) {
     std::string lower = entry;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    if (entry != dist.first && lower.find("dist") != std::string::npos && lower != "distortion_model") {
-      t.fail(key, name + ": '" + entry + "' is not read" +
-                      (dist.first.empty() ? "" : " ('" + dist.first + "' is)") +
-                      "; expected the distortion as 'distortion_coefficients' (OpenCV, ROS), 'dist_coeffs', "
-                      "'distCoeffs' or 'D', once");
+    if (lower.find("dist") != std::string::npos && lower != "distortion_model") {
+      t.fail(key, name + ": '" + entry + "' is not read; expected the distortion as 'distortion_coefficients' "
+                      "(OpenCV, ROS), 'dist_coeffs', 'distCoeffs' or 'D'");
     }
   }
   if (!dist.first.empty()) {

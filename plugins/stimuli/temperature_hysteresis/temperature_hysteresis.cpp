@@ -70,7 +70,7 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
       char text[200];
       std::snprintf(text, sizeof text,
                     "a reading of %g, outside the %g to %g C temperature_hysteresis takes: expected degrees Celsius%s",
-                    value, kLowestC, kHighestC, value > 200 && value < 500 ? " (a log in kelvin: subtract 273.15)" : "");
+                    value, kLowestC, kHighestC, value > 200 && value < 500 ? " (kelvin: subtract 273.15)" : "");
       throw gtrack::InputError(text);
     }
     if (std::isfinite(value)) {
