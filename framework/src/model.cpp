@@ -82,7 +82,6 @@ double twice_area(const std::vector<Eigen::Vector2d>& polygon) {
   return a;
 }
 
-// Distance from p to the closed polygon's outline.
 double distance_to_outline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon) {
   double d = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < polygon.size(); ++k) {

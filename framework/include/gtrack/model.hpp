@@ -118,6 +118,9 @@ class GTRACK_API ArticulatedModel {
 // its points must run counter-clockwise around a convex polygon.
 GTRACK_API std::string palm_shape_mismatch(const std::vector<Eigen::Vector2d>& palm);
 
+// The distance from `p` to the nearest side of the closed polygon.
+GTRACK_API double distance_to_outline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon);
+
 // Why a geometry's symmetry_order does not hold ("" when it does): a turn
 // by 360/order must take every palm point onto a palm point and every finger
 // onto a finger of the same links, at its hinge and in its direction.

@@ -17,7 +17,6 @@
 #include <filesystem>
 #include <gtrack/error.hpp>
 #include <cstdio>
-#include <limits>
 #include <gtrack/plugin.hpp>
 
 namespace {
@@ -39,17 +38,6 @@ std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
     links.push_back({lengths[j], widths[j], widths[j + 1]});
   }
   return links;
-}
-
-// The distance from `p` to the nearest side of the polygon `outline`.
-double distance_to_outline(const std::vector<Eigen::Vector2d>& outline, const Eigen::Vector2d& p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < outline.size(); ++i) {
-    const Eigen::Vector2d a = outline[i], ab = outline[(i + 1) % outline.size()] - a;
-    const double s = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + s * ab - p).norm());
-  }
-  return best;
 }
 
 gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
@@ -90,7 +78,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
       F.base_mm = {b[0], b[1]};
       // The first hinge sits on the palm's outline; a finger elsewhere is
       // drawn floating, or out of the palm's middle, without a word.
-      const double off = distance_to_outline(g.palm_mm, F.base_mm);
+      const double off = gtrack::distance_to_outline(F.base_mm, g.palm_mm);
       if (off > 0.05 * palm_radius) {
         char text[160];
         std::snprintf(text, sizeof text, "[%g, %g] is %.3g mm off the palm's outline; expected a point on it",
