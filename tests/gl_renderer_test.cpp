@@ -196,12 +196,14 @@ struct Scene {
   cv::Mat observation;    // at render size
 };
 
-// The scene given to each renderer: model, projection at kScale, observation.
-void set_scene(std::initializer_list<Renderer*> renderers, const Scene& s) {
+// The scene given to each renderer: model, projection at kScale,
+// observation, and the occlusion rim when one is given.
+void set_scene(std::initializer_list<Renderer*> renderers, const Scene& s, const cv::Mat& rim = {}) {
   for (Renderer* r : renderers) {
     r->set_model(s.model);
     r->set_projection(s.projection, kScale);
     r->set_observation(s.observation);
+    if (!rim.empty()) r->set_rim(rim);
   }
 }
 
@@ -305,10 +307,8 @@ TEST(GlRenderer, RimCountsAgreeWithCpu) {
   Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
   const Eigen::MatrixXd H = camera_hypotheses(300, 17, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(3));
-  const cv::Mat rim = ring_around(s.observation);
   auto cpu = make_cpu();
-  set_scene({gl.get(), cpu.get()}, s);
-  for (Renderer* r : {gl.get(), cpu.get()}) r->set_rim(rim);
+  set_scene({gl.get(), cpu.get()}, s, ring_around(s.observation));
   std::vector<PairCounts> from_gl, from_cpu;
   gl->evaluate(H, from_gl);
   cpu->evaluate(H, from_cpu);
@@ -338,11 +338,9 @@ TEST(GlRenderer, ANewProjectionClearsTheObservationAndRimAsCpuDoes) {
   Scene s{ArticulatedModel(hydrogel_geometry()), camera(), {}};
   const Eigen::MatrixXd H = camera_hypotheses(100, 23, s.model.fingers());
   s.observation = observation_for(s, H.leftCols(4));
-  const cv::Mat rim = ring_around(s.observation);
   auto cpu = make_cpu();
   std::vector<PairCounts> from_gl, from_cpu;
-  set_scene({gl.get(), cpu.get()}, s);
-  for (Renderer* r : {gl.get(), cpu.get()}) r->set_rim(rim);
+  set_scene({gl.get(), cpu.get()}, s, ring_around(s.observation));
   // Uploaded to the GPU by a batch before the projection is set again.
   gl->evaluate(H, from_gl);
   ASSERT_GT(gl->observation_count(), 0u);
