@@ -365,6 +365,13 @@ TEST(Fault, CorruptImageInFolderStopsWithTheFramesBefore) {
   EXPECT_NE(summary.find("\"frames\": 5,"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"stopped_by\": \""), std::string::npos) << summary;
   EXPECT_NE(summary.find("000005.png: cannot read the image"), std::string::npos) << summary;
+  // Resumed before the image is mended, the run stops at once, and says
+  // the earlier frames are still there.
+  gtrack::TrackOptions again = o;
+  again.resume = true;
+  const std::string e = track_error(r, again);
+  EXPECT_NE(e.find("; the 5 frames before it are kept in"), std::string::npos) << e;
+  EXPECT_EQ(read_text(o.out_dir / "summary.json"), summary);
 }
 
 // A stimulus log shorter than the video: every frame is tracked, the frames

@@ -538,12 +538,14 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     // An error part way (an unreadable image, a log that shrank): the
     // frames done stay, the summary says what stopped the run, and the
     // error, still one line, says where they are.
-    if (summary.frames == 0) throw;
+    if (summary.frames_before + summary.frames == 0) throw;
     std::string kept;
     try {
       summary.stopped_by = e.what();
       finish();
-      write_summary(options.out_dir / "summary.json", summary);
+      // A resumed run that stops at its first frame leaves the earlier
+      // run's summary as it was.
+      if (summary.frames > 0) write_summary(options.out_dir / "summary.json", summary);
       const int done = summary.frames_before + summary.frames;
       const bool resumable = !options.follow_stimulus && options.input.rfind("camera:", 0) != 0;
       kept = fmt::format("; the {} frame{} before it {} kept in {}{}", done, done == 1 ? "" : "s",
