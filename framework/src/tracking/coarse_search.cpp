@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <numeric>
 #include <optional>
+#include <utility>
 #include <opencv2/imgproc.hpp>
 
 #include "gtrack/log.hpp"
@@ -178,7 +179,15 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
 
   // The grid around the observed pixel (u, v), each point at its best place
   // (below), with the cost of each.
-  const bool observed = cv::countNonZero(*in.observation) > 0;
+  const cv::Moments mo = cv::moments(*in.observation, true);
+  const bool observed = mo.m00 > 0;
+  // The model's radius in render pixels at a point.
+  const auto radius_px_at = [&](const Eigen::Vector3d& point) {
+    const Eigen::Vector3d aside = point + Eigen::Vector3d(model.radius_mm(), 0, 0);
+    return (render::dehomogenise(render::project(in.render_projection, aside)) -
+            render::dehomogenise(render::project(in.render_projection, point)))
+        .norm();
+  };
   const auto grid_at = [&](double u, double v) {
     Eigen::MatrixXd grid(dims, static_cast<Eigen::Index>(rotations.size() * joints.size()));
     const Eigen::Vector3d centre = lift_pixel(in.render_projection, u, v, in.nominal_mm);
@@ -233,10 +242,7 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
       const Eigen::Vector2d outward = steps > 0 ? border_outward(*in.observation) : Eigen::Vector2d::Zero();
       if (outward.norm() > 0) {
         const Eigen::Vector2d along(-outward.y(), outward.x());
-        const Eigen::Vector2d c0 = render::dehomogenise(render::project(in.render_projection, centre));
-        const Eigen::Vector2d c1 = render::dehomogenise(
-            render::project(in.render_projection, centre + Eigen::Vector3d(model.radius_mm(), 0, 0)));
-        const double step = kBorderStepRadii * (c1 - c0).norm();
+        const double step = kBorderStepRadii * radius_px_at(centre);
         Eigen::MatrixXd moved(dims, grid.cols() * steps);
         for (Eigen::Index i = 0; i < grid.cols(); ++i) {
           for (int k = 0; k < steps; ++k) {
@@ -256,23 +262,17 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
       }
     }
 
-    return std::make_pair(grid, scores);
+    return std::make_pair(std::move(grid), std::move(scores));
   };
   // Around the centroid of O; and, when O holds apart a blob of its own
   // (the gripper beside a bright reflector, a caliper mark or clutter that
   // passes the bounds), around the largest blob too: the centroid of all
   // of them can lie on none.
-  const cv::Moments mo = cv::moments(*in.observation, true);
   const double u = observed ? mo.m10 / mo.m00 + 0.5 : in.observation->cols * 0.5;
   const double v = observed ? mo.m01 / mo.m00 + 0.5 : in.observation->rows * 0.5;
   auto [grid, scores] = grid_at(u, v);
   if (const auto blob = largest_blob_centre(*in.observation)) {
-    const Eigen::Vector3d centre = lift_pixel(in.render_projection, u, v, in.nominal_mm);
-    const double radius_px =
-        (render::dehomogenise(render::project(in.render_projection, centre + Eigen::Vector3d(model.radius_mm(), 0, 0))) -
-         render::dehomogenise(render::project(in.render_projection, centre)))
-            .norm();
-    if ((*blob - Eigen::Vector2d(u, v)).norm() > radius_px) {
+    if ((*blob - Eigen::Vector2d(u, v)).norm() > radius_px_at(lift_pixel(in.render_projection, u, v, in.nominal_mm))) {
       logger().debug("coarse search: also from O's largest blob, at ({:.0f}, {:.0f}) render pixels, {:.0f} from O's "
                      "centroid",
                      blob->x(), blob->y(), (*blob - Eigen::Vector2d(u, v)).norm());
