@@ -272,26 +272,26 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     for (const auto& row : table.rows) reference_rows[row.frame] = row.h;
   }
   int restarts_used = 0, references_used = 0;
-  if (options.stimulus_csv) {
-    // Each row is fed to an instance of the stimulus plugin of its own as it
-    // is read, so that a reading the plugin refuses (a temperature in
-    // kelvin) is an error naming its line, before a frame is tracked.
-    StimulusLog::ReadingCheck check;
-    if (setup.loader && setup.stimulus) {
-      check = [probe = setup.loader->make_stimulus(setup.root.table("stimulus")), row = 0](double value) mutable {
-        probe->update(value, row++);
-      };
-    }
-    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
-                                  : StimulusLog::load(*options.stimulus_csv, std::move(check));
+  // The readings are checked before a frame is tracked, by an instance of
+  // the stimulus plugin of its own: the configured default, and each log row
+  // as it is read, so that one the plugin refuses (a temperature in kelvin)
+  // is an error naming its key or its line.
+  std::shared_ptr<Stimulus> probe;
+  if (setup.loader && setup.stimulus && (options.stimulus_csv || config.tracker.default_stimulus)) {
+    probe = setup.loader->make_stimulus(setup.root.table("stimulus"));
   }
-  // The reading every frame takes without a log, checked as a log's rows are.
-  if (!options.stimulus_csv && config.tracker.default_stimulus && setup.loader && setup.stimulus) {
+  if (probe && config.tracker.default_stimulus) {
     try {
-      setup.loader->make_stimulus(setup.root.table("stimulus"))->update(*config.tracker.default_stimulus, 0);
+      probe->update(*config.tracker.default_stimulus, 0);
     } catch (const std::exception& e) {
       throw ConfigError(setup.root.table("tracker").where("default_stimulus") + ": " + e.what());
     }
+  }
+  if (options.stimulus_csv) {
+    StimulusLog::ReadingCheck check;
+    if (probe) check = [probe, row = 1](double value) mutable { probe->update(value, row++); };
+    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
+                                  : StimulusLog::load(*options.stimulus_csv, std::move(check));
   }
   // Resuming: the saved state says which frame was done last; the source
   // starts at the next frame of the range.
