@@ -1,18 +1,11 @@
 // gtrack plugins: one line per plugin found (kind, name, version, file).
 #include <algorithm>
-#include <filesystem>
 #include <iostream>
 
 #include "command.hpp"
 #include "gtrack/plugin_loader.hpp"
 
 namespace {
-
-// `other` exists and is not the same file as `taken`.
-bool fs_exists_apart(const std::filesystem::path& other, const std::filesystem::path& taken) {
-  std::error_code ec;
-  return std::filesystem::exists(other, ec) && !std::filesystem::equivalent(other, taken, ec) && !ec;
-}
 
 int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_options::variables_map& vm) {
   gtrack::PluginLoader loader(common.plugin_paths);
@@ -35,11 +28,8 @@ int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_o
   // The first file of a name is the one taken: copies further down the
   // search path (another build, an older install) are said, on stderr.
   for (const auto& r : records) {
-    for (const auto& dir : loader.search_paths()) {
-      const std::filesystem::path other = dir / r.file.filename();
-      if (fs_exists_apart(other, r.file)) {
-        std::cerr << "note: " << other.string() << " is set aside: " << r.file.string() << " is found first\n";
-      }
+    for (const auto& other : loader.set_aside_by(r.file)) {
+      std::cerr << "note: " << other.string() << " is set aside: " << r.file.string() << " is found first\n";
     }
   }
   return 0;

@@ -220,6 +220,19 @@ std::vector<PluginRecord> PluginLoader::discover() const {
   return out;
 }
 
+std::vector<fs::path> PluginLoader::set_aside_by(const fs::path& taken) const {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  auto dir = std::find_if(paths_.begin(), paths_.end(),
+                          [&](const fs::path& d) { return fs::equivalent(d, taken.parent_path(), ec); });
+  if (dir == paths_.end()) return out;
+  for (++dir; dir != paths_.end(); ++dir) {
+    const fs::path other = *dir / taken.filename();
+    if (fs::exists(other, ec) && !fs::equivalent(other, taken, ec) && !ec) out.push_back(other);
+  }
+  return out;
+}
+
 fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
   // A name is a file name part, never a path.
   const bool word = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
@@ -229,24 +242,21 @@ fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
     throw PluginError(std::string(to_string(kind)) + " plugin name '" + name +
                       "': expected letters, digits, '_', '-' or '.' (a name, not a path; use plugin_path for folders)");
   }
-  for (auto dir = paths_.begin(); dir != paths_.end(); ++dir) {
-    fs::path f = *dir / library_file_name(name);
+  for (const auto& dir : paths_) {
+    fs::path f = dir / library_file_name(name);
     std::error_code ec;
     if (!fs::exists(f, ec)) continue;
     // A plugin of the same name further down the search path (a built-in
     // one, say) is set aside: said, since the run then differs from one
     // without the folder.
-    for (auto later = std::next(dir); later != paths_.end(); ++later) {
-      const fs::path other = *later / library_file_name(name);
-      if (!fs::exists(other, ec) || fs::equivalent(f, other, ec)) continue;  // none, or the same file again
+    if (const auto aside = set_aside_by(f); !aside.empty()) {
       static std::mutex mutex;
       static std::set<fs::path> said;  // once a file: a replayed stimulus is made again each frame
       const std::lock_guard<std::mutex> lock(mutex);
       if (said.insert(f).second) {
         logger().info("{} plugin '{}' taken from {}, ahead of the one in {}", to_string(kind), name, f.string(),
-                      later->string());
+                      aside.front().parent_path().string());
       }
-      break;
     }
     return f;
   }

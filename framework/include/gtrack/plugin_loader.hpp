@@ -44,6 +44,9 @@ class GTRACK_API PluginLoader {
   // Every valid plugin found (first of each name wins); libraries that fail a
   // check are skipped with a warning in the log.
   std::vector<PluginRecord> discover() const;
+  // The other files of `taken`'s name in the folders searched after its own
+  // (the same file found again is none): the plugins it sets aside.
+  std::vector<std::filesystem::path> set_aside_by(const std::filesystem::path& taken) const;
 
   // Loads the plugin named by table["plugin"], checks it, constructs it from
   // the table and checks that every key of the table was read. The instance
