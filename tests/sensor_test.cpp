@@ -139,7 +139,8 @@ TEST(PinholeMicroscope, ReadsOpenCvCalibrationFiles) {
   {
     cv::FileStorage out(interactive.string(), cv::FileStorage::WRITE);
     out << "cameraResolution" << cv::Size(640, 480) << "cameraMatrix" << K << "dist_coeffs" << D.colRange(0, 5)
-        << "cameraMatrix_std_dev" << cv::Mat::zeros(4, 1, CV_64F) << "dist_coeffs_std_dev" << cv::Mat::zeros(5, 1, CV_64F);
+        << "cameraMatrix_std_dev" << cv::Mat::zeros(4, 1, CV_64F) << "dist_coeffs_std_dev"
+        << cv::Mat::zeros(5, 1, CV_64F);
   }
   expect_same_camera(keys, make_sensor("plugin = \"pinhole_microscope\"\ncalibration = \"" + interactive.string() + "\""));
   // JSON with the matrix as rows.

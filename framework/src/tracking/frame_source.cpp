@@ -85,7 +85,8 @@ std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_s
 void check_size(const cv::Mat& img, ImageSize expected, const std::string& what) {
   if (img.cols != expected.width || img.rows != expected.height) {
     throw InputError(what + ": image is " + size_text(img.cols, img.rows) + " but the sensor expects " +
-                     size_text(expected.width, expected.height) + " (the size [sensor] gives: its width/height, or its calibration file's image size)");
+                     size_text(expected.width, expected.height) +
+                     " (the size [sensor] gives: its width/height, or its calibration file's image size)");
   }
 }
 

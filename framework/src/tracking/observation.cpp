@@ -17,12 +17,11 @@ Segmenter::Segmenter(ObservationConfig config, ImageSize image, ImageSize render
 
 cv::Mat Segmenter::segment(const cv::Mat& frame, std::optional<cv::Rect> roi) const {
   if (frame.cols != image_.width || frame.rows != image_.height || frame.type() != CV_8UC3) {
-    const int depth_bits[] = {8, 8, 16, 16, 32, 32, 64, 16};
     throw InputError("observation: expected a " + std::to_string(image_.width) + "x" + std::to_string(image_.height) +
                      " BGR image of 8 bits a channel (3 channels), got " + std::to_string(frame.cols) + "x" +
                      std::to_string(frame.rows) + " with " + std::to_string(frame.channels()) +
                      (frame.channels() == 1 ? " channel" : " channels") + " of " +
-                     std::to_string(depth_bits[frame.depth()]) + " bits (convert it with cv::cvtColor and convertTo first)");
+                     std::to_string(8 * frame.elemSize1()) + " bits (convert it with cv::cvtColor and convertTo first)");
   }
   const cv::Rect full(0, 0, image_.width, image_.height);
   const cv::Rect area = roi ? (*roi & full) : full;

@@ -374,8 +374,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
             log->source(), log->first_key(), index, time_s));
       }
       if (!warned_range) {
-        logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.{}f} to {:.{}f}; "
-                      "holding its nearest reading",
+        logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.{}f} to "
+                      "{:.{}f}; holding its nearest reading",
                       log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(), by_time ? 3 : 0,
                       log->last_key(), by_time ? 3 : 0);
         warned_range = true;

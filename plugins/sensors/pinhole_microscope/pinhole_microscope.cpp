@@ -157,12 +157,14 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
   // Without one of those, an entry that names a distortion otherwise would
   // be dropped without a word, leaving the lens uncorrected. (Beside one,
   // others are the calibration's own extras: dist_coeffs_std_dev.)
-  for (const std::string& entry : dist.first.empty() ? in.root().keys() : std::vector<std::string>{}) {
-    std::string lower = entry;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    if (lower.find("dist") != std::string::npos && lower != "distortion_model") {
-      t.fail(key, name + ": '" + entry + "' is not read; expected the distortion as 'distortion_coefficients' "
-                      "(OpenCV, ROS), 'dist_coeffs', 'distCoeffs' or 'D'");
+  if (dist.first.empty()) {
+    for (const std::string& entry : in.root().keys()) {
+      std::string lower = entry;
+      std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
+      if (lower.find("dist") != std::string::npos && lower != "distortion_model") {
+        t.fail(key, name + ": '" + entry + "' is not read; expected the distortion as 'distortion_coefficients' "
+                        "(OpenCV, ROS), 'dist_coeffs', 'distCoeffs' or 'D'");
+      }
     }
   }
   if (!dist.first.empty()) {
