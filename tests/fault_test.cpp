@@ -34,6 +34,7 @@
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "support/logged.hpp"
 #include "gtrack/setup.hpp"
 #include "gtrack/text_file.hpp"
 #include "gtrack/tracker.hpp"
@@ -261,12 +262,8 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
   // A config's frame rate set over the video's own is said.
   TrackRun at_30 = make_run();
   at_30.config.tracker.fps = 30;
-  std::ostringstream log;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
-  gtrack::track_sequence(at_30.setup, at_30.config, o);
-  gtrack::logger().sinks().pop_back();
-  EXPECT_NE(log.str().find("clip.avi: the video says 10 frames/s, [tracker] fps = 30 is taken"), std::string::npos)
-      << log.str();
+  const std::string log = gtrack::testing::logged([&] { gtrack::track_sequence(at_30.setup, at_30.config, o); });
+  EXPECT_NE(log.find("clip.avi: the video says 10 frames/s, [tracker] fps = 30 is taken"), std::string::npos) << log;
 }
 
 // Grey images for a segmentation by colour: every frame would be lost
@@ -276,21 +273,20 @@ TEST(Fault, TruncatedVideoKeepsTheFramesThatDecode) {
 TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
   TrackRun r = make_run();
   const auto warnings_of = [&](const fs::path& frames, const fs::path& out) {
-    std::ostringstream log;
-    gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
     gtrack::TrackOptions o;
     o.input = frames.string();
     o.out_dir = out;
     o.progress = false;
     std::string error;
-    try {
-      gtrack::track_sequence(r.setup, r.config, o);
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    gtrack::logger().sinks().pop_back();
+    const std::string log = gtrack::testing::logged([&] {
+      try {
+        gtrack::track_sequence(r.setup, r.config, o);
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    });
     EXPECT_EQ(error, "");
-    return log.str();
+    return log;
   };
   const fs::path dir = fresh_dir("grey");
   const fs::path colour = write_frames(dir / "colour", 3);
@@ -389,13 +385,11 @@ TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {
   o.progress = false;
   std::vector<std::optional<double>> readings;
   o.on_frame = [&](const gtrack::Estimate& e) { readings.push_back(e.stimulus); };
-  std::ostringstream log;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
-  const auto s = gtrack::track_sequence(r.setup, r.config, o);
-  gtrack::logger().sinks().pop_back();
+  gtrack::TrackSummary s;
+  const std::string log = gtrack::testing::logged([&] { s = gtrack::track_sequence(r.setup, r.config, o); });
   const std::string said = "stimulus.csv: frame 3 (t = 0.100 s) is outside the stimulus log, whose rows cover frames 0 to 2";
-  EXPECT_NE(log.str().find(said), std::string::npos) << log.str();
-  EXPECT_EQ(log.str().find("is outside the stimulus log"), log.str().rfind("is outside the stimulus log")) << log.str();
+  EXPECT_NE(log.find(said), std::string::npos) << log;
+  EXPECT_EQ(log.find("is outside the stimulus log"), log.rfind("is outside the stimulus log")) << log;
   EXPECT_EQ(s.frames, kFrames);
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), static_cast<size_t>(kFrames));
   ASSERT_EQ(readings.size(), static_cast<size_t>(kFrames));
@@ -752,13 +746,9 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
   // to be unreadable when the run is resumed.
   std::ofstream(dir / "out" / "overlay.mp4") << std::string(48, '\0');
   second.overlay = true;
-  std::ostringstream log;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
   r = load();
-  gtrack::track_sequence(r.setup, r.config, second);
-  gtrack::logger().sinks().pop_back();
-  EXPECT_NE(log.str().find("overlay.mp4: cannot be read (not closed by the run that wrote it"), std::string::npos)
-      << log.str();
+  const std::string log = gtrack::testing::logged([&] { gtrack::track_sequence(r.setup, r.config, second); });
+  EXPECT_NE(log.find("overlay.mp4: cannot be read (not closed by the run that wrote it"), std::string::npos) << log;
 }
 
 // Killed while writing (power cut, kill -9): a row cut short, or written
@@ -1236,11 +1226,7 @@ TEST(TextFile, BoundsAndFailedWritesAreOneLineErrors) {
 // sizes; the shipped scale is not.
 TEST(Fault, AGripperAFewPixelsAcrossIsWarnedAbout) {
   const auto warnings = [](const std::string& text) {
-    std::ostringstream log;
-    gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
-    const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(text, "units.toml"), {});
-    gtrack::logger().sinks().pop_back();
-    return log.str();
+    return gtrack::testing::logged([&] { gtrack::load_setup(gtrack::ConfigTable::parse(text, "units.toml"), {}); });
   };
   EXPECT_EQ(warnings(kConfig).find("pixels across"), std::string::npos) << warnings(kConfig);
   std::string tiny = kConfig;

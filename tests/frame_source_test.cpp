@@ -14,12 +14,11 @@
 #include <string>
 #include <vector>
 
-#include <spdlog/sinks/ostream_sink.h>
 #include <tiffio.h>
-#include <sstream>
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "support/logged.hpp"
 
 namespace fs = std::filesystem;
 
@@ -243,20 +242,7 @@ TEST(FrameSource, EachPageOfATiffStackIsAFrame) {
 
 namespace {
 
-// The logger's lines while `f` runs.
-template <class F>
-std::string logged(F&& f) {
-  std::ostringstream log;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
-  try {
-    f();
-  } catch (...) {
-    gtrack::logger().sinks().pop_back();
-    throw;
-  }
-  gtrack::logger().sinks().pop_back();
-  return log.str();
-}
+using gtrack::testing::logged;
 
 }  // namespace
 

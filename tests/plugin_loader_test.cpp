@@ -6,12 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <spdlog/sinks/ostream_sink.h>
-#include <sstream>
 #include <gtrack/error.hpp>
-#include <gtrack/log.hpp>
 #include <gtrack/plugin_loader.hpp>
 #include <gtrack/setup.hpp>
+
+#include "support/logged.hpp"
 
 namespace fs = std::filesystem;
 
@@ -222,25 +221,22 @@ TEST(PluginLoader, APluginThatSetsAnotherAsideIsSaidOnce) {
   fs::create_directories(dir);
   fs::copy_file(kFixtures / "libgtrack_fixture_good_sensor.so", dir / "libgtrack_fixture_good_sensor.so");
   gtrack::PluginLoader loader({dir, kFixtures});
-  std::ostringstream log;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
-  loader.make_sensor(table("fixture_good_sensor"));
-  loader.make_sensor(table("fixture_good_sensor"));
+  const std::string log = gtrack::testing::logged([&] {
+    loader.make_sensor(table("fixture_good_sensor"));
+    loader.make_sensor(table("fixture_good_sensor"));
+  });
   int listed = 0;
   for (const auto& r : loader.discover()) listed += r.name == "fixture_good_sensor";
-  gtrack::logger().sinks().pop_back();
   const std::string said = "sensor plugin 'fixture_good_sensor' taken from " +
                            (dir / "libgtrack_fixture_good_sensor.so").string() + ", ahead of the one in " +
                            kFixtures.string();
-  EXPECT_NE(log.str().find(said), std::string::npos) << log.str();
-  EXPECT_EQ(log.str().find(said), log.str().rfind(said)) << "said once: " << log.str();
+  EXPECT_NE(log.find(said), std::string::npos) << log;
+  EXPECT_EQ(log.find(said), log.rfind(said)) << "said once: " << log;
   EXPECT_EQ(listed, 1);
   // The same folder twice is no other plugin.
-  std::ostringstream again;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(again));
-  gtrack::PluginLoader({kFixtures, kFixtures}).make_sensor(table("fixture_good_sensor"));
-  gtrack::logger().sinks().pop_back();
-  EXPECT_EQ(again.str().find("ahead of"), std::string::npos) << again.str();
+  const std::string again = gtrack::testing::logged(
+      [&] { gtrack::PluginLoader({kFixtures, kFixtures}).make_sensor(table("fixture_good_sensor")); });
+  EXPECT_EQ(again.find("ahead of"), std::string::npos) << again;
   fs::remove_all(dir);
 }
 

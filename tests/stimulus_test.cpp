@@ -9,14 +9,13 @@
 #include <iterator>
 #include <memory>
 #include <numbers>
-#include <sstream>
-#include <spdlog/sinks/ostream_sink.h>
 #include <string>
 #include <vector>
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/setup.hpp"
+#include "support/logged.hpp"
 #include "support/plugins.hpp"
 
 using gtrack::testing::make_stimulus;
@@ -200,17 +199,7 @@ std::string setup_warnings(const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   if (at == std::string::npos) return "config line not found: " + from;
   text.replace(at, from.size(), to);
-  std::ostringstream log;
-  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
-  gtrack::logger().sinks().push_back(sink);
-  try {
-    gtrack::load_setup(gtrack::ConfigTable::parse(text, "refs.toml"), {});
-  } catch (...) {
-    gtrack::logger().sinks().pop_back();
-    throw;
-  }
-  gtrack::logger().sinks().pop_back();
-  return log.str();
+  return gtrack::testing::logged([&] { gtrack::load_setup(gtrack::ConfigTable::parse(text, "refs.toml"), {}); });
 }
 
 TEST(Setup, WarnsWhenTheStimulusReferenceJointsDifferFromTheGripper) {
