@@ -204,7 +204,7 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
         two.substr(two.find("[[finger]]\nbase_mm = [-0.2, -0.2]"));
   two.erase(two.find("[[finger]]\nbase_mm = [0.2, -0.2]"));
   const std::string e = config_error(two);
-  EXPECT_NE(e.find("<test>:4: key 'symmetry_order': a turn by 90 deg takes finger 1: its hinge to [-0.2, 0.2], "
+  EXPECT_NE(e.find("<test>:4: key 'symmetry_order': a turn by 90 deg takes finger 1's hinge to [-0.2, 0.2], "
                    "where no finger has its hinge"),
             std::string::npos)
       << e;
@@ -217,12 +217,12 @@ TEST(DataDefinedGripper, ASymmetryTheShapeDoesNotHaveIsRefused) {
       << config_error(oblong);
   std::string longer = kFourFinger;
   longer.replace(longer.rfind("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 0.4]");
-  EXPECT_NE(config_error(longer).find("key 'symmetry_order': a turn by 90 deg takes finger 3: it onto finger 4, "
+  EXPECT_NE(config_error(longer).find("key 'symmetry_order': a turn by 90 deg takes finger 3 onto finger 4, "
                                       "whose links differ"),
             std::string::npos)
       << config_error(longer);
   const std::string turned = with(kFourFinger, "direction_deg = 135", "direction_deg = 150");
-  EXPECT_NE(config_error(turned).find("takes finger 1: its direction to 135 deg, where finger 2 at its hinge points "
+  EXPECT_NE(config_error(turned).find("takes finger 1's direction to 135 deg, where finger 2 at its hinge points "
                                       "to 150 deg"),
             std::string::npos)
       << config_error(turned);

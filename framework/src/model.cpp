@@ -212,19 +212,19 @@ std::string symmetry_mismatch(const GripperGeometry& G, std::vector<int>* finger
       const FingerShape& b = G.fingers[nearest];
       std::string why;
       if (hinge_apart(nearest) > tol) {
-        why = "its hinge to " + point(base) + ", where no finger has its hinge (nearest: finger " +
+        why = "'s hinge to " + point(base) + ", where no finger has its hinge (nearest: finger " +
               std::to_string(nearest + 1) + " at " + point(b.base_mm) + ")";
       } else if (turned_apart(nearest) > 1.0) {
         char text[128];
-        std::snprintf(text, sizeof text, "its direction to %g deg, where finger %d at its hinge points to %g deg",
+        std::snprintf(text, sizeof text, "'s direction to %g deg, where finger %d at its hinge points to %g deg",
                       shown(std::remainder(direction, 360.0)), nearest + 1, b.direction_deg);
         why = text;
       } else if (!same_links(a, b)) {
-        why = "it onto finger " + std::to_string(nearest + 1) + ", whose links differ";
+        why = " onto finger " + std::to_string(nearest + 1) + ", whose links differ";
       } else {
-        why = "it onto finger " + std::to_string(nearest + 1) + ", where another finger lands as well";
+        why = " onto finger " + std::to_string(nearest + 1) + ", where another finger lands as well";
       }
-      return head + "finger " + std::to_string(f + 1) + ": " + why + tail;
+      return head + "finger " + std::to_string(f + 1) + why + tail;
     }
     taken[target] = true;
     shift[f] = target;
