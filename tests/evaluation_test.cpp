@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <fstream>
+#include <numbers>
 
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
@@ -42,6 +43,29 @@ TEST(Evaluation, SymmetricEquivalentScoresZero) {
     EXPECT_NEAR(e.position_um, 0, 1e-9) << k;
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(e.axis_deg[a], 0, 1e-6) << k;
   }
+}
+
+TEST(Evaluation, ErrorsAboutEachAxisStaySmallAtNinetyDegreesOfTilt) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  // At ry = 90 deg, rx and rz trade off: Euler differences of these two
+  // near-equal poses would be 30 deg about x and z.
+  const Eigen::VectorXd truth = pose(0, 0, 100, 30, 90, 10, {10, 10, 10, 10, 10, 10});
+  Eigen::VectorXd est = truth;
+  est[4] = 89.9;
+  const auto e = gtrack::compare_to_truth(m, truth, est);
+  EXPECT_NEAR(e.orientation_deg, 0.1, 1e-6);
+  for (int a = 0; a < 3; ++a) EXPECT_LE(e.axis_deg[a], 0.1 + 1e-6) << a;
+  EXPECT_NEAR(e.axis_deg.norm(), e.orientation_deg, 1e-9);
+  // A turn about the world's x axis alone is an error about x alone.
+  const Eigen::VectorXd flat = pose(0, 0, 100, 0, 0, 0, {10, 10, 10, 10, 10, 10});
+  Eigen::VectorXd turned = flat;
+  turned.segment<3>(3) = gtrack::euler_deg_from_rotation(
+      Eigen::AngleAxisd(5 * std::numbers::pi / 180, Eigen::Vector3d::UnitX()).toRotationMatrix());
+  const auto x = gtrack::compare_to_truth(m, flat, turned);
+  EXPECT_NEAR(x.axis_deg[0], 5, 1e-6);
+  EXPECT_NEAR(x.axis_deg[1], 0, 1e-6);
+  EXPECT_NEAR(x.axis_deg[2], 0, 1e-6);
 }
 
 TEST(Evaluation, ErrorsAreInMicrometresAndDegrees) {

@@ -7,7 +7,7 @@
 // by 60 degrees with its fingers renumbered is the same physical thing and
 // must score zero. Errors: palm-centre position (3D, in the image plane x-y,
 // depth z; micrometres), orientation (geodesic angle between the rotations,
-// and per Euler axis; degrees), joints (mean absolute over fingers; degrees)
+// and split about the x, y, z axes; degrees), joints (mean absolute over fingers; degrees)
 // and the mean distance between corresponding phalanx endpoints
 // (micrometres, the paper's Fig. 6 metric).
 //
@@ -52,9 +52,11 @@ struct FrameErrors {
   // for a camera looking down world z.
   double position_um = 0, inplane_um = 0, depth_um = 0;
   double orientation_deg = 0;
-  // |Euler angle differences| about x, y, z: the sensor's own axes when
-  // evaluate() has the sensor (SensorFrame; the world's for one looking
-  // down z), else the world's.
+  // The rotation from the truth's orientation to the estimate's, split
+  // about x, y, z (|components of its rotation vector|; their squares sum
+  // to orientation_deg's): the sensor's own axes when evaluate() has the
+  // sensor (SensorFrame; the world's for one looking down z), else the
+  // world's.
   Eigen::Vector3d axis_deg{0, 0, 0};
   double joint_deg = 0;
   double endpoint_um = 0;

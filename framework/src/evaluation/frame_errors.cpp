@@ -9,8 +9,6 @@ namespace gtrack {
 
 namespace {
 
-double wrap_deg(double a) { return std::abs(std::remainder(a, 360.0)); }
-
 double mean_endpoint_distance(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
   double sum = 0;
   for (size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]).norm();
@@ -74,9 +72,7 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
   FrameErrors best;
   double best_end = 0;
   for (int k = 0; k < order; ++k) {
-    Eigen::VectorXd e = model.symmetric_equivalent(estimate, k);
-    // One Euler branch for both sides, so that per-axis differences mean something.
-    e.segment<3>(3) = euler_deg_from_rotation(rotation_from_euler_deg(e[3], e[4], e[5]));
+    const Eigen::VectorXd e = model.symmetric_equivalent(estimate, k);
     const double end = mean_endpoint_distance(model.link_endpoints(e), truth_ends);
     // The first equivalent is always taken, so that an error that is not
     // finite is reported as such, never as the default of 0.
@@ -90,9 +86,14 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
     const double along = d.dot(viewing_axis);
     f.inplane_um = 1000 * (d - along * viewing_axis).norm();
     f.depth_um = 1000 * std::abs(along);
-    const Eigen::Vector3d te = euler_deg_from_rotation(rotation_from_euler_deg(truth[3], truth[4], truth[5]));
-    f.orientation_deg = geodesic_angle_deg(te, e.segment<3>(3));
-    for (int a = 0; a < 3; ++a) f.axis_deg[a] = wrap_deg(e[3 + a] - te[a]);
+    // The rotation taking the truth to the estimate (angle-axis: acos is
+    // ill-conditioned near 0), split about the frame's own axes: unlike
+    // Euler differences, its parts stay small near ry = +-90 deg, where rx
+    // and rz trade off freely.
+    const Eigen::AngleAxisd turn(rotation_from_euler_deg(e[3], e[4], e[5]) *
+                                 rotation_from_euler_deg(truth[3], truth[4], truth[5]).transpose());
+    f.orientation_deg = turn.angle() * 180.0 / std::numbers::pi;
+    f.axis_deg = (f.orientation_deg * turn.axis()).cwiseAbs();
     const int F = model.fingers();
     double joints = 0;
     for (int j = 0; j < F; ++j) joints += std::abs(e[kPoseDims + j] - truth[kPoseDims + j]);
