@@ -153,6 +153,8 @@ struct Cell {
 
 Cell run_cell(const Context& c, double noise, int particles, int generations) {
   Cell cell;
+  // Each error's frames pooled over the sequences (gtrack::pooled).
+  std::vector<gtrack::ErrorStats> endpoint, inplane, depth, orientation, joints;
   for (int s = 0; s < c.sequences; ++s) {
     const fs::path dir = make_sequence(c, c.synth.seed + s, noise);
     const gtrack::Setup setup = gtrack::load_synthetic_setup(dir, c.common.plugin_paths);
@@ -162,18 +164,23 @@ Cell run_cell(const Context& c, double noise, int particles, int generations) {
     cfg.tracker.overlay = false;
     const auto run = gtrack::run_synthetic_benchmark(setup, cfg, dir);
     const auto& e = run.evaluation.in_view;
-    const double w = 1.0 / c.sequences;
-    cell.endpoint += w * e.endpoint_um.mean;
-    cell.endpoint_sd += w * e.endpoint_um.std;
-    cell.inplane += w * e.position_inplane_um.mean;
-    cell.depth += w * e.depth_um.mean;
-    cell.orientation += w * e.orientation_deg.mean;
-    cell.joints += w * e.joint_deg.mean;
-    cell.joints_sd += w * e.joint_deg.std;
-    cell.fps += w * run.tracker_fps;
+    endpoint.push_back(e.endpoint_um);
+    inplane.push_back(e.position_inplane_um);
+    depth.push_back(e.depth_um);
+    orientation.push_back(e.orientation_deg);
+    joints.push_back(e.joint_deg);
+    cell.fps += run.tracker_fps / c.sequences;
     cell.lost += run.evaluation.lost_in_view_frames;
     cell.frames += run.frames;
   }
+  const gtrack::ErrorStats ends = gtrack::pooled(endpoint), folds = gtrack::pooled(joints);
+  cell.endpoint = ends.mean;
+  cell.endpoint_sd = ends.std;
+  cell.inplane = gtrack::pooled(inplane).mean;
+  cell.depth = gtrack::pooled(depth).mean;
+  cell.orientation = gtrack::pooled(orientation).mean;
+  cell.joints = folds.mean;
+  cell.joints_sd = folds.std;
   return cell;
 }
 

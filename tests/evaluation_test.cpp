@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <fstream>
 #include <numbers>
 
@@ -66,6 +67,19 @@ TEST(Evaluation, ErrorsAboutEachAxisStaySmallAtNinetyDegreesOfTilt) {
   EXPECT_NEAR(x.axis_deg[0], 5, 1e-6);
   EXPECT_NEAR(x.axis_deg[1], 0, 1e-6);
   EXPECT_NEAR(x.axis_deg[2], 0, 1e-6);
+}
+
+TEST(Evaluation, PooledStatisticsAreThoseOfAllTheFrames) {
+  // {1, 2, 3} and {10, 20} taken as {1, 2, 3, 10, 20}.
+  gtrack::ErrorStats a, b, none;
+  a.mean = 2, a.std = std::sqrt(2.0 / 3), a.max = 3, a.count = 3;
+  b.mean = 15, b.std = 5, b.max = 20, b.count = 2;
+  const gtrack::ErrorStats all = gtrack::pooled({a, none, b});
+  EXPECT_EQ(all.count, 5);
+  EXPECT_NEAR(all.mean, 7.2, 1e-12);
+  EXPECT_NEAR(all.std, std::sqrt(102.8 - 7.2 * 7.2), 1e-12);
+  EXPECT_EQ(all.max, 20);
+  EXPECT_TRUE(std::isnan(all.median));
 }
 
 TEST(Evaluation, ErrorsAreInMicrometresAndDegrees) {

@@ -46,6 +46,12 @@ struct ErrorStats {
   int count = 0;
 };
 
+// The statistics of several sets of frames taken as one (a sweep's cell
+// over its sequences): each part weighs by its count, and the spread
+// between the parts' means counts in std. The median cannot be pooled and
+// is NaN.
+GTRACK_API ErrorStats pooled(const std::vector<ErrorStats>& parts);
+
 struct FrameErrors {
   // depth_um along the sensor's viewing axis (a camera's optical axis, the
   // normal of an ultrasound slice), inplane_um across it: world z and x-y

@@ -1,6 +1,7 @@
 // Aggregating per-frame errors: in view, out of view, lost, recovery.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -48,6 +49,24 @@ double in_view_from_sensor(const ArticulatedModel& model, const Sensor& sensor, 
 }
 
 }  // namespace
+
+ErrorStats pooled(const std::vector<ErrorStats>& parts) {
+  ErrorStats out;
+  double sum = 0, squares = 0;
+  for (const ErrorStats& p : parts) {
+    if (p.count == 0) continue;
+    out.max = out.count ? std::max(out.max, p.max) : p.max;
+    out.count += p.count;
+    sum += p.count * p.mean;
+    squares += p.count * (p.std * p.std + p.mean * p.mean);
+  }
+  if (out.count > 0) {
+    out.mean = sum / out.count;
+    out.std = std::sqrt(std::max(0.0, squares / out.count - out.mean * out.mean));
+  }
+  out.median = std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
 
 void ErrorSet::add(const FrameErrors& e) {
   const double v[9] = {e.position_um, e.inplane_um,  e.depth_um,    e.orientation_deg, e.joint_deg,
