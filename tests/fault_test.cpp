@@ -751,6 +751,35 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
   EXPECT_NE(log.find("overlay.mp4: cannot be read (not closed by the run that wrote it"), std::string::npos) << log;
 }
 
+// --frames A:B starts at A with what the log said before it: a gripper
+// heated past folding before frame A and then held inside the hysteresis
+// band is still folded there, by the readings of the frames not tracked.
+// Without them the run is the same as one whose log never went above the
+// band.
+TEST(Fault, ARunFromFrameATakesTheLogsReadingsBeforeIt) {
+  const fs::path dir = fresh_dir("frames_from");
+  const CliRun synth = gtrack_cli("synth --frames 8 --seed 3 --out " + (dir / "seq").string());
+  ASSERT_EQ(synth.code, 0) << synth.output;
+  const fs::path heated = dir / "heated.csv", cool = dir / "cool.csv";
+  std::ofstream(heated) << "frame,value\n0,22.0\n1,29.0\n2,29.0\n3,25.5\n5,25.5\n7,25.5\n";
+  std::ofstream(cool) << "frame,value\n0,22.0\n1,22.0\n2,22.0\n3,25.5\n5,25.5\n7,25.5\n";
+  const std::string config = read_text(dir / "seq" / "sequence.toml") + "[render]\nbackend = \"cpu\"\n";
+  const auto run = [&](const fs::path& log, const std::string& out) {
+    TrackRun r{gtrack::load_setup(gtrack::ConfigTable::parse(config, "sequence.toml"), {}), {}};
+    r.config = gtrack::engine_config(r.setup);
+    gtrack::TrackOptions o;
+    o.input = (dir / "seq" / "frames").string();
+    o.stimulus_csv = log;
+    o.range.first = 5;
+    o.overlay = false;
+    o.progress = false;
+    return tracked_rows(r, o, dir / out);
+  };
+  const auto after_heating = run(heated, "heated"), without = run(cool, "cool");
+  ASSERT_EQ(after_heating.size(), 4u);  // the header and frames 5, 6, 7
+  EXPECT_NE(after_heating, without);
+}
+
 // Killed while writing (power cut, kill -9): a row cut short, or written
 // after the last saved state, is dropped and tracked again.
 TEST(Fault, ResumeDropsRowsPastTheSavedState) {

@@ -418,10 +418,27 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     fs::create_directories(options.out_dir / "masks", ec);
     if (ec) throw InputError((options.out_dir / "masks").string() + ": cannot create (" + ec.message() + ")");
   }
+  // The stimulus plugin's state (a latch that has closed, a fold under way)
+  // holds what the log said before each tracked frame: the readings of the
+  // frames not tracked, before --frames A:B's first and between --every's,
+  // are fed to it as well, in order (those the log has; a followed log has
+  // only its last).
+  int fed = 0;  // the frames before this one have been fed
+  const auto feed_untracked = [&](int index) {
+    if (log && !options.follow_stimulus) {
+      for (; fed < index; ++fed) {
+        if (const auto r = log->value_at(fed, fed / fps)) tracker.replay_stimulus(r, fed / fps);
+      }
+    }
+    fed = std::max(fed, index + 1);
+  };
   if (resumed) {
     // The stimulus plugin's state is rebuilt by replaying the readings of
     // the frames already done, in order.
-    for (const int index : done) tracker.replay_stimulus(reading_at(index, index / fps), index / fps);
+    for (const int index : done) {
+      feed_untracked(index);
+      tracker.replay_stimulus(reading_at(index, index / fps), index / fps);
+    }
     logger().info("resuming after frame {} ({} frames already in {})", resumed->frame, done.size(),
                   options.out_dir.string());
   }
@@ -483,6 +500,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       }
       double io_ms = (seconds_since(t_read) - frame->waited_s) * 1e3;
       const double time_s = frame->index / fps;
+      feed_untracked(frame->index);
       const std::optional<double> reading = reading_at(frame->index, time_s);
 
       if (!restart_rows.empty()) {
