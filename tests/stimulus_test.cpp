@@ -111,6 +111,37 @@ TEST(TemperatureHysteresis, MetallicGrippersFoldAtTriggerAndNeverUnfold) {
   EXPECT_DOUBLE_EQ(s->target_joint_deg(70.0), 70.0);
 }
 
+// A recording made after the gripper was heated: `triggered = true` starts
+// with the latch closed, whatever the log reads.
+TEST(TemperatureHysteresis, ALatchClosedBeforeTheRecordingIsSaidInTheTable) {
+  auto s = make_stimulus(std::string(kMetallic) + "\ntriggered = true");
+  ramp(*s, 25.0, 25.0, 5);
+  EXPECT_DOUBLE_EQ(s->penalty(std::vector<double>(6, 70.0)), 0.0);
+  EXPECT_DOUBLE_EQ(s->target_joint_deg(0.0), 70.0);
+}
+
+// A threshold of the other mode is refused, naming its key, rather than
+// left unread while the gripper is folded by this mode's defaults (a
+// metallic gripper given trigger_C without mode = "latching" was folded
+// by the hydrogel's 24-27 C band).
+TEST(TemperatureHysteresis, TheOtherModesKeysAreRefused) {
+  const auto error = [](const std::string& table) {
+    try {
+      make_stimulus(table);
+    } catch (const gtrack::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string hydrogel = error("plugin = \"temperature_hysteresis\"\ntrigger_C = 37");
+  EXPECT_NE(hydrogel.find("key 'trigger_C': is read only with mode = \"latching\""), std::string::npos) << hydrogel;
+  EXPECT_NE(error("plugin = \"temperature_hysteresis\"\ntriggered = true").find("key 'triggered'"),
+            std::string::npos);
+  const std::string metallic = error(std::string(kMetallic) + "\nfold_above_C = 40");
+  EXPECT_NE(metallic.find("key 'fold_above_C': is read only with mode = \"reversible\""), std::string::npos)
+      << metallic;
+}
+
 // A material with a first-order response of time constant tau, driven the
 // way the synthetic sequences drive it, against the feasible range of a
 // stimulus that knows the response time within a factor of two.

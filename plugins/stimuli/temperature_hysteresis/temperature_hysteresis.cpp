@@ -57,7 +57,21 @@ class TemperatureHysteresis final : public gtrack::Stimulus {
     fold_bias_ = t.number_or("fold_bias", 0.75, Range::closed(0.5, 1.0));
     settle_s_ = t.number_or("settle_s", 3.0, Range::non_negative());
     response_s_ = t.number_or("response_s", 0.0, Range::non_negative());
-    if (mode_ == "reversible" && !(unfold_below_ < fold_above_)) {
+    // A threshold of the other mode would be left unread, and the gripper
+    // folded by the defaults of this one.
+    const bool latching = mode_ == "latching";
+    for (const char* key : {"unfold_below_C", "fold_above_C", "trigger_C", "triggered"}) {
+      const bool latch_key = std::string(key).rfind("trigger", 0) == 0;
+      if (t.has(key) && latch_key != latching) {
+        t.fail(key, std::string("is read only with mode = \"") + (latching ? "reversible" : "latching") + "\" (" +
+                        (latching ? "a hydrogel's fold both ways" : "a metallic gripper's one-way fold") +
+                        "); set that mode, or remove the key");
+      }
+    }
+    // The latch closed before the recording's first frame (a gripper heated
+    // earlier): the log's readings need not reach trigger_C.
+    triggered_ = t.boolean_or("triggered", false);
+    if (!latching && !(unfold_below_ < fold_above_)) {
       t.fail("fold_above_C", "must be greater than unfold_below_C");
     }
     if (folded_ == unfolded_) t.fail("folded_deg", "must differ from unfolded_deg");
