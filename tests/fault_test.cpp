@@ -399,6 +399,24 @@ TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {
   }
 }
 
+// A time_s log written with four decimals ends at the last frame's time
+// rounded down (7 / 30 s as 0.2333): that frame is within the log, and no
+// warning is given; a log that ends a frame earlier is warned about.
+TEST(Fault, ATimeLogRoundedToFewDecimalsCoversItsLastFrame) {
+  const fs::path dir = fresh_dir("rounded_stimulus");
+  const TrackRun r = make_run();
+  const auto warned = [&](const std::string& last_row) {
+    const fs::path csv = dir / "stimulus.csv";
+    std::ofstream(csv) << "time_s,value\n0.0000,22.0\n0.1000,22.5\n" << last_row << ",23.0\n";
+    gtrack::TrackOptions o = folder_run(dir, kFrames);
+    o.stimulus_csv = csv;
+    const std::string log = gtrack::testing::logged([&] { gtrack::track_sequence(r.setup, r.config, o); });
+    return log.find("is outside the stimulus log") != std::string::npos;
+  };
+  EXPECT_FALSE(warned("0.2333"));
+  EXPECT_TRUE(warned("0.2000"));
+}
+
 // A live run follows a log that a temperature logger is still writing: each
 // frame takes the latest whole row, and a row half written waits for its end.
 TEST(Fault, FollowedStimulusLogGivesEachFrameTheLatestReading) {

@@ -373,7 +373,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
             "from the recording's first frame (a log in Unix time needs its first frame's time subtracted)",
             log->source(), log->first_key(), index, time_s));
       }
-      if (!warned_range) {
+      // A time written with few decimals (59 / 15 s as 3.9333) is the
+      // frame's own row: within half a frame of the log's ends, no warning.
+      const bool rounded = by_time && time_s > log->first_key() - 0.5 / fps && time_s < log->last_key() + 0.5 / fps;
+      if (!warned_range && !rounded) {
         logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.{}f} to "
                       "{:.{}f}; holding its nearest reading",
                       log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(), by_time ? 3 : 0,
