@@ -37,17 +37,30 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   so.plugin_paths = common.plugin_paths;
   gtrack::Setup setup = gtrack::load_setup(config, so);
   // A config given without --preset: the preset whose config it is, else
-  // one of the look the config segments (grey levels for luminance, as an
-  // ultrasound slice's default is; colour otherwise), so that the frames
-  // are ones the config can track.
+  // the one whose config names the same gripper plugin (a lab's own copy
+  // of a shipped config), else one of the look the config segments (grey
+  // levels for luminance, as an ultrasound slice's default is; colour
+  // otherwise), so that the frames are ones the config can track.
   const bool grey_look = gtrack::observation_color_space(setup.root.table("observation"), *setup.sensor) == "luminance";
   const auto grey = [](const gtrack::SynthPreset& p) { return p.gripper_hsv[1] == 0; };
   if (vm.count("config") && vm["preset"].defaulted()) {
     const auto& all = gtrack::synth_presets();
+    const auto gripper_of = [](const gtrack::ConfigTable& root) {
+      return root.table("gripper").string_or("plugin", "");
+    };
+    const std::string gripper = gripper_of(setup.root);
     const auto same = std::find_if(all.begin(), all.end(), [&](const auto& p) {
       return p.config == config.filename() && grey(p) == grey_look;
     });
-    o.preset = same != all.end() ? same->name : grey_look ? "ultrasound" : "microscope";
+    const auto same_gripper = std::find_if(all.begin(), all.end(), [&](const auto& p) {
+      return grey(p) == grey_look &&
+             gripper_of(gtrack::ConfigTable::load_file((gtrack::data_dir() / "configs" / p.config).string())) ==
+                 gripper;
+    });
+    o.preset = same != all.end()           ? same->name
+               : same_gripper != all.end() ? same_gripper->name
+               : grey_look                 ? "ultrasound"
+                                           : "microscope";
   }
   if (const bool grey_frames = grey(gtrack::synth_preset(o.preset)); grey_frames != grey_look) {
     gtrack::logger().warn("--preset {} draws {} frames, but {} segments {}: its config will not find the "
@@ -92,8 +105,9 @@ GTRACK_COMMAND(
           "seed,s", po::value<std::string>()->default_value("1"), "random seed: same seed, same sequence")(
           "preset", po::value<std::string>()->default_value("microscope"),
           ("setup: motion, look and noise; one of " + gtrack::synth_preset_names() +
-           ". With --config and no --preset: the preset whose config has the config's file name, else "
-           "microscope, or ultrasound for a config that segments grey levels")
+           ". With --config and no --preset: the preset whose config has the config's file name, else the one "
+           "whose config names the same gripper plugin, else microscope, or ultrasound for a config that "
+           "segments grey levels")
               .c_str())(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(

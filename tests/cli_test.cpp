@@ -876,8 +876,9 @@ TEST(Cli, SweepChecksItsConfigAndFolderFirst) {
 // config given as a pipe is read once.
 // synth --config without --preset draws what the config's sensor segments:
 // an ultrasound config (here a copy under another name) gets the
-// ultrasound preset's grey frames; a preset whose look the sensor does not
-// segment is warned about.
+// ultrasound preset's grey frames, a copy of a metallic config its
+// gripper's preset; a preset whose look the sensor does not segment is
+// warned about.
 TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_preset";
   fs::remove_all(dir);
@@ -903,6 +904,12 @@ TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
                                           "\n[observation]\ncolor_space = \"luminance\"\n");
   r = gtrack("synth --config " + grey_camera.string() + " --frames 1 --out " + (dir / "c").string());
   EXPECT_NE(r.output.find("(preset ultrasound, seed 1)"), std::string::npos) << r.output;
+  // A lab's copy of a metallic config, under its own name, gets the preset
+  // of that gripper: the hydrogel preset's stimulus never folds it.
+  const fs::path two = write("synth_preset_two.toml", read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" /
+                                                                "microscope_metallic_two.toml"));
+  r = gtrack("synth --config " + two.string() + " --frames 1 --out " + (dir / "d").string());
+  EXPECT_NE(r.output.find("(preset metallic_two, seed 1)"), std::string::npos) << r.output;
   r = gtrack("synth --config " + lab.string() + " --preset microscope --frames 1 --out " + (dir / "b").string());
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("--preset microscope draws colour frames, but " + lab.string() + " segments grey levels"),
