@@ -10,8 +10,9 @@ namespace gtrack::detail {
 cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const ArticulatedModel& model,
                       const Stimulus* stimulus, const Estimate& estimate) {
   cv::Mat out = frame.clone();
-  const cv::Scalar green(0, 220, 0);
   const bool lost = estimate.status == TrackStatus::Lost;
+  // Green, orange for a lost frame's held estimate, fill and outline alike.
+  const cv::Scalar colour = lost ? cv::Scalar(0, 160, 255) : cv::Scalar(0, 220, 0);
   if (estimate.hypothesis.size() == model.dims()) {
     std::vector<Eigen::Vector3d> tris;
     model.pose(estimate.hypothesis, tris);
@@ -31,9 +32,9 @@ cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const Articula
       outlines.push_back(std::move(poly));
     }
     cv::Mat tinted = out.clone();
-    tinted.setTo(green, fill);
+    tinted.setTo(colour, fill);
     cv::addWeighted(out, 0.55, tinted, 0.45, 0, out);
-    cv::polylines(out, outlines, true, lost ? cv::Scalar(0, 160, 255) : green, 1, cv::LINE_AA, shift);
+    cv::polylines(out, outlines, true, colour, 1, cv::LINE_AA, shift);
   }
   const double font = std::max(0.5, frame.rows / 900.0);
   const int thick = std::max(1, static_cast<int>(font * 1.5));
