@@ -55,6 +55,36 @@ TEST(Synth, SegmentedFrameMatchesTheRenderedTruth) {
   EXPECT_GE(checked, 2);
 }
 
+// A camera with lens distortion draws its frames through the lens: the
+// frame the tracker undistorts (Sensor::rectify) is the one a camera
+// without distortion draws, and the frame itself is not.
+TEST(Synth, FramesAreDrawnThroughTheLensTheTrackerUndistorts) {
+  const std::string text = "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\nfx = 3200.0\n"
+                           "distortion = [-50, 0, 0, 0]\n[gripper]\nplugin = \"hydrogel_six_finger\"\n[stimulus]\n"
+                           "plugin = \"temperature_hysteresis\"\n";
+  std::string plain = text;
+  plain.replace(plain.find("distortion = [-50, 0, 0, 0]\n"), 28, "");
+  const gtrack::Setup lens = gtrack::load_setup(gtrack::ConfigTable::parse(text, "lens.toml"), {});
+  const gtrack::Setup none = gtrack::load_setup(gtrack::ConfigTable::parse(plain, "none.toml"), {});
+  gtrack::SynthOptions o;
+  o.frames = 4;
+  o.seed = 3;
+  const auto a = gtrack::plan_sequence(lens, o), b = gtrack::plan_sequence(none, o);
+  EXPECT_FALSE(a.lens_map.empty());
+  EXPECT_TRUE(b.lens_map.empty());
+  const gtrack::ObservationConfig oc;
+  gtrack::Segmenter seg(oc, {256, 256}, {256, 256});
+  const auto iou = [](const cv::Mat& x, const cv::Mat& y) {
+    return static_cast<double>(cv::countNonZero(x & y)) / cv::countNonZero(x | y);
+  };
+  for (int i = 0; i < o.frames; ++i) {
+    const cv::Mat drawn = gtrack::render_frame(lens, a, i, nullptr);
+    const cv::Mat linear = seg.observe(gtrack::render_frame(none, b, i, nullptr)).mask;
+    EXPECT_GT(iou(seg.observe(lens.sensor->rectify(drawn)).mask, linear), 0.97) << "frame " << i;
+    EXPECT_LT(iou(seg.observe(drawn).mask, linear), 0.9) << "frame " << i;
+  }
+}
+
 // A probe turned in the world (its slice now the world's x-z plane) gets
 // the sequence an upright one gets, turned with it: every frame's palm
 // centre in its slab and its palm facing along the slice's normal as much

@@ -114,6 +114,9 @@ struct SynthPlan {
   SynthPreset preset;
   SynthOptions options;
   std::vector<SynthFrame> frames;
+  // The sensor's lens distortion, applied to every frame drawn with the
+  // linear projection (a cv::remap map; empty: none).
+  cv::Mat lens_map;
 };
 
 // What was drawn: shares of the gripper's full shape (at full resolution).

@@ -1,5 +1,8 @@
 #include "synth/appearance.hpp"
 
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
@@ -75,6 +78,70 @@ cv::Mat degrade(cv::Mat& image, double blur_sigma_px, const SynthPreset& p, std:
   cv::Mat out;
   image.convertTo(out, CV_8UC3);  // saturates to 0..255
   return out;
+}
+
+cv::Mat lens_map(const Sensor& sensor) {
+  const Projection linear = sensor.projection();
+  const Eigen::Matrix<double, 3, 4>& m = linear.world_to_image;
+  const Eigen::Vector3d axis = viewing_axis(linear), nominal = sensor.nominal_position_mm();
+  // The linear image's pixel (u, v) (centres at +0.5) on the nominal plane,
+  // then where the full model draws that point.
+  const auto drawn_at = [&](const Eigen::Vector2d& uv) -> std::optional<Eigen::Vector2d> {
+    Eigen::Matrix3d a;
+    Eigen::Vector3d b;
+    a.row(0) = (m.row(0) - uv.x() * m.row(2)).head<3>();
+    a.row(1) = (m.row(1) - uv.y() * m.row(2)).head<3>();
+    a.row(2) = axis.transpose();
+    b << -(m(0, 3) - uv.x() * m(2, 3)), -(m(1, 3) - uv.y() * m(2, 3)), axis.dot(nominal);
+    const Eigen::Vector3d x = a.fullPivLu().solve(b);
+    if (!x.allFinite()) return std::nullopt;
+    return sensor.project(x);
+  };
+  const ImageSize size = sensor.image_size();
+  const int w = size.width, h = size.height;
+  // Is there any? A 9 x 9 sample of the image.
+  double worst = 0;
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 8; ++j) {
+      const Eigen::Vector2d uv(w * i / 8.0, h * j / 8.0);
+      const auto d = drawn_at(uv);
+      worst = std::max(worst, d ? (*d - uv).norm() : 1.0);
+    }
+  }
+  if (worst < 0.01) return {};
+  // The inverse, on a grid every kStep pixels (the distortion is smooth):
+  // the linear pixel u that the lens draws at d, by fixed-point steps
+  // u += d - drawn_at(u); then interpolated to every pixel.
+  constexpr int kStep = 8;
+  const int gw = (w - 1) / kStep + 2, gh = (h - 1) / kStep + 2;
+  cv::Mat grid(gh, gw, CV_64FC2);
+  for (int gy = 0; gy < gh; ++gy) {
+    for (int gx = 0; gx < gw; ++gx) {
+      const Eigen::Vector2d d(gx * kStep + 0.5, gy * kStep + 0.5);
+      Eigen::Vector2d u = d;
+      for (int it = 0; it < 50; ++it) {
+        const auto f = drawn_at(u);
+        if (!f) break;
+        const Eigen::Vector2d step = d - *f;
+        u += step;
+        if (step.norm() < 1e-4) break;
+      }
+      grid.at<cv::Vec2d>(gy, gx) = cv::Vec2d(u.x() - 0.5, u.y() - 0.5);  // OpenCV's pixel centres
+    }
+  }
+  cv::Mat map(h, w, CV_32FC2);
+  for (int y = 0; y < h; ++y) {
+    const int gy = y / kStep;
+    const double fy = (y - gy * kStep) / double(kStep);
+    for (int x = 0; x < w; ++x) {
+      const int gx = x / kStep;
+      const double fx = (x - gx * kStep) / double(kStep);
+      const cv::Vec2d p = (1 - fy) * ((1 - fx) * grid.at<cv::Vec2d>(gy, gx) + fx * grid.at<cv::Vec2d>(gy, gx + 1)) +
+                          fy * ((1 - fx) * grid.at<cv::Vec2d>(gy + 1, gx) + fx * grid.at<cv::Vec2d>(gy + 1, gx + 1));
+      map.at<cv::Vec2f>(y, x) = cv::Vec2f(static_cast<float>(p[0]), static_cast<float>(p[1]));
+    }
+  }
+  return map;
 }
 
 }  // namespace gtrack::synth

@@ -190,6 +190,13 @@ cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int index, Synth
   if (full_area > 0) vis.visible = (in_view_area - covered) / full_area;
   if (visibility) *visibility = vis;
 
+  // Through the lens: the tracker undistorts the frame back (Sensor::rectify).
+  // What falls outside the linear image repeats its border.
+  if (!plan.lens_map.empty()) {
+    cv::Mat through;
+    cv::remap(image, through, plan.lens_map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    image = through;
+  }
   const double defocus = p.blur_sigma_px + p.defocus_px_per_mm * std::abs(fr.truth[2] - sensor.nominal_position_mm().z());
   return synth::degrade(image, defocus, p, frame_seed(plan.options.seed, index));
 }

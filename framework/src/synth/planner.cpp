@@ -18,6 +18,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/model.hpp"
 #include "gtrack/synth.hpp"
+#include "synth/appearance.hpp"
 #include "synth/smooth_path.hpp"
 
 namespace gtrack {
@@ -138,6 +139,7 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   const SynthPreset& p = plan.preset;
   const ArticulatedModel& model = setup.model();
   const Sensor& sensor = *setup.sensor;
+  plan.lens_map = synth::lens_map(sensor);
   std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ull + 17);
   std::uniform_real_distribution<double> u(0, 1);
 
