@@ -540,6 +540,41 @@ TEST(TrackCommand, SigintLeavesCompleteRows) { interrupt_leaves_complete_rows(SI
 TEST(TrackCommand, SighupLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGHUP, "seq_sighup"); }
 TEST(TrackCommand, SighupUnderNohupIsIgnored) { interrupt_leaves_complete_rows(SIGINT, "seq_nohup", true); }
 
+// `gtrack synth` stopped part way (Ctrl-C) in the folder of an earlier
+// sequence: the earlier sequence's truth is gone before any new frame is
+// drawn, so no new frame is scored against it, and every frame written is
+// whole.
+TEST(SynthCommand, StoppedPartWayLeavesNoTruthBesideItsFrames) {
+  const fs::path dir = temp_dir("synth_stopped");
+  const std::string exe = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack";
+  const std::string out = (dir / "seq").string();
+  ASSERT_EQ(std::system((exe + " synth --frames 2 --out " + out + " > /dev/null").c_str()), 0);
+  ASSERT_TRUE(fs::exists(dir / "seq" / "ground_truth.csv"));
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(exe.c_str(), exe.c_str(), "synth", "--frames", "300", "--seed", "7", "--threads", "1", "--out", out.c_str(),
+          "--log-level", "warn", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!fs::exists(dir / "seq" / "frames" / "000003.png") &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  kill(pid, SIGINT);
+  waitpid(pid, nullptr, 0);
+  EXPECT_FALSE(fs::exists(dir / "seq" / "ground_truth.csv"));
+  int frames = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "seq" / "frames")) {
+    if (entry.path().extension() != ".png") continue;
+    ++frames;
+    EXPECT_FALSE(cv::imread(entry.path().string()).empty()) << entry.path();
+  }
+  EXPECT_GE(frames, 4);
+  EXPECT_LT(frames, 300);
+}
+
 TEST(TrackSequence, WrongImageSizeNamesFileAndSizes) {
   const fs::path dir = temp_dir("wrong_size");
   cv::imwrite((dir / "a.png").string(), cv::Mat(100, 120, CV_8UC3, cv::Scalar(0, 0, 0)));

@@ -27,10 +27,15 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   fs::create_directories(out / "frames", ec);
   if (ec) throw InputError(out.string() + ": cannot create the folder (" + ec.message() + ")");
   // The frames of an earlier sequence in the same folder would be tracked
-  // with this one's.
-  if (const int stale = remove_frame_images(out / "frames")) {
-    logger().info("{}: removed the {} frames of an earlier sequence", (out / "frames").string(), stale);
+  // with this one's, and its truth, left beside frames of this one by a run
+  // stopped part way (Ctrl-C), would score them: both go first. The truth
+  // is written once every frame is.
+  int stale = remove_frame_images(out / "frames");
+  for (const char* name : {"ground_truth.csv", "stimulus.csv", "sequence.toml"}) stale += fs::remove(out / name, ec);
+  for (const auto& entry : fs::directory_iterator(out / "frames", ec)) {
+    if (entry.path().extension() == ".part") fs::remove(entry.path(), ec);  // a frame a stopped run was writing
   }
+  if (stale > 0) logger().info("{}: removed the files of an earlier sequence", out.string());
 
   const int n = static_cast<int>(plan.frames.size());
   std::vector<SynthVisibility> vis(n);
@@ -47,9 +52,16 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
         std::snprintf(name, sizeof name, "%06d.png", i);
         const fs::path file = out / "frames" / name;
         // Fast PNG compression: the sequence is written once and read often.
-        if (!cv::imwrite(file.string(), img, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-          throw InputError(file.string() + ": cannot write");
+        // Written aside and renamed: a frame is whole or absent.
+        std::vector<std::uint8_t> png;
+        if (!cv::imencode(".png", img, png, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+          throw InputError(file.string() + ": cannot encode");
         }
+        const fs::path part = out / "frames" / ("." + std::string(name) + ".part");
+        write_text_file(part, std::string(png.begin(), png.end()));
+        std::error_code renamed;
+        fs::rename(part, file, renamed);
+        if (renamed) throw InputError(file.string() + ": cannot write (" + renamed.message() + ")");
       } catch (const std::exception& e) {
         std::lock_guard lock(failure_mutex);
         failure = e.what();
