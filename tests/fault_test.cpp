@@ -6,6 +6,9 @@
 // finished before the fault present and well-formed in estimates.csv.
 // Runs are tiny (128x128 frames, N=8, G=2) so the whole file takes seconds.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 #include <gtrack/results.hpp>
 #include <algorithm>
 #include <chrono>
@@ -368,6 +371,52 @@ TEST(Fault, CorruptImageInFolderStopsWithTheFramesBefore) {
   const std::string e = track_error(r, again);
   EXPECT_NE(e.find("; the 5 frames before it are kept in"), std::string::npos) << e;
   EXPECT_EQ(read_text(o.out_dir / "summary.json"), summary);
+}
+
+// A run whose input fails at its first frame (another image size) leaves
+// the earlier run in its folder as it was; so does a followed folder that
+// never gets an image.
+TEST(Fault, AnInputThatFailsAtOnceLeavesTheEarlierRun) {
+  const fs::path dir = fresh_dir("fails_at_once");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  gtrack::track_sequence(r.setup, r.config, o);
+  const std::string rows = read_text(o.out_dir / "estimates.csv"), summary = read_text(o.out_dir / "summary.json");
+  fs::create_directories(dir / "other");
+  cv::imwrite((dir / "other" / "000000.png").string(), cv::Mat(kSide / 2, kSide, CV_8UC3, cv::Scalar::all(40)));
+  gtrack::TrackOptions other = o;
+  other.input = (dir / "other").string();
+  EXPECT_THROW(gtrack::track_sequence(r.setup, r.config, other), gtrack::InputError);
+  fs::create_directories(dir / "empty");
+  other.input = (dir / "empty").string();
+  other.follow_input_s = 0.2;
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, other).frames, 0);
+  EXPECT_EQ(read_text(o.out_dir / "estimates.csv"), rows);
+  EXPECT_EQ(read_text(o.out_dir / "summary.json"), summary);
+}
+
+// A second run into a folder another run is writing is refused, naming the
+// other's pid: two runs had written each other's rows into the same files.
+TEST(Fault, ASecondRunIntoABusyFolderIsRefused) {
+  const fs::path dir = fresh_dir("busy");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, 2);
+  fs::create_directories(o.out_dir);
+  // The other run's lock, as it holds it.
+  const int fd = ::open((o.out_dir / ".gtrack_lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::write(fd, "4242", 4), 4);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    ADD_FAILURE() << "a second run wrote into a busy folder";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another gtrack track run is writing there (pid 4242)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(o.out_dir / "estimates.csv"));
+  ::close(fd);  // the other run ends: the folder is free
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 2);
 }
 
 // A stimulus log shorter than the video: every frame is tracked, the frames

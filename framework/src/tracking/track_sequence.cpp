@@ -1,9 +1,12 @@
 // `gtrack track` as a library call: source -> Tracker -> files.
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -236,6 +239,40 @@ class ObservationAdvice {
 
 }  // namespace
 
+namespace {
+
+// An exclusive lock on an output folder (flock on DIR/.gtrack_lock, which
+// holds the owner's pid), held while a run writes there.
+class OutputLock {
+ public:
+  explicit OutputLock(const fs::path& dir) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(dir.string() + ": cannot create the output folder (" + ec.message() + ")");
+    const fs::path file = dir / ".gtrack_lock";
+    fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw InputError(file.string() + ": cannot open (" + std::strerror(errno) + ")");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      char pid[32] = {};
+      const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
+      ::close(fd_);
+      const std::string who = n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : "";
+      throw InputError(dir.string() + ": another gtrack track run is writing there" + who +
+                       "; wait for it to end, or choose another --out");
+    }
+    const std::string me = std::to_string(::getpid());
+    if (::ftruncate(fd_, 0) == 0) (void)!::pwrite(fd_, me.data(), me.size(), 0);
+  }
+  ~OutputLock() { ::close(fd_); }
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
 TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
   const auto start = Clock::now();
   const SensorFrame view = sensor_frame(*setup.sensor);  // symmetric equivalents are compared in it
@@ -388,6 +425,33 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     return reading;
   };
 
+  // The first frame is read before an earlier run in the folder is
+  // replaced: an input that fails at once (another image size, a video
+  // that does not decode) leaves that run as it was, and so does a
+  // followed folder that never gets an image.
+  std::optional<Frame> pending;
+  double pending_read_s = 0;
+  if (!resumed) {
+    const auto t = Clock::now();
+    pending = source->next();
+    pending_read_s = seconds_since(t);
+    if (!pending) {
+      // A damaged video that stops before the range's first frame.
+      if (const std::string ended = source->ended_early(); !ended.empty()) {
+        throw InputError(options.input + ": " + ended + ", before the first frame of --frames " +
+                         std::to_string(range.first) + ":" + (range.last >= 0 ? std::to_string(range.last) : "") +
+                         "; nothing was tracked");
+      }
+      logger().warn("{}: no frame to track; {} is left as it was", options.input, options.out_dir.string());
+      TrackSummary none;
+      none.cancelled = options.cancel && options.cancel->load();
+      return none;
+    }
+  }
+  bool pending_taken = !pending.has_value();
+  // One run at a time in a folder: two would write each other's rows into
+  // the same files. The lock goes with the process, however it ends.
+  const OutputLock lock(options.out_dir);
   Tracker tracker(setup, config);
   if (resumed) {
     // Refused (a state of another setup) before any file is touched.
@@ -411,7 +475,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     const bool earlier = fs::exists(options.out_dir / "estimates.csv");
     if (clear_previous_run(options.out_dir) > 0 || earlier) {
-      logger().info("{} holds an earlier run: it is replaced", options.out_dir.string());
+      logger().warn("{} holds an earlier run: it is replaced (--resume would have gone on with it)",
+                    options.out_dir.string());
     }
   }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
@@ -494,14 +559,22 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         break;
       }
       const auto t_read = Clock::now();
-      std::optional<Frame> frame = source->next();
+      std::optional<Frame> frame;
+      double read_s = pending_read_s;
+      if (!pending_taken) {
+        frame = std::move(pending);
+        pending_taken = true;
+      } else {
+        frame = source->next();
+        read_s = seconds_since(t_read);
+      }
       if (!frame) {
         // A followed folder's wait ends at a cancel as at its idle limit; any
         // other source has simply ended.
         summary.cancelled = options.follow_input_s > 0 && options.cancel && options.cancel->load();
         break;
       }
-      double io_ms = (seconds_since(t_read) - frame->waited_s) * 1e3;
+      double io_ms = (read_s - frame->waited_s) * 1e3;
       const double time_s = frame->index / fps;
       feed_untracked(frame->index);
       const std::optional<double> reading = reading_at(frame->index, time_s);
@@ -592,12 +665,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   warn_unused(options.score_truth, reference_rows, references_used, "--score-truth", "a tracked frame");
   // Resuming a finished run tracks nothing: its summary stays as it was.
   if (!(resumed && summary.frames == 0)) write_summary(options.out_dir / "summary.json", summary);
-  // A damaged video that stops before the range's first frame gives nothing.
-  if (!resumed && summary.frames == 0 && !summary.cancelled && !summary.input_ended_early.empty()) {
-    throw InputError(options.input + ": " + summary.input_ended_early + ", before the first frame of --frames " +
-                     std::to_string(range.first) + ":" + (range.last >= 0 ? std::to_string(range.last) : "") +
-                     "; nothing was tracked");
-  }
   return summary;
 }
 
