@@ -972,6 +972,10 @@ TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
   other.range.every = 2;
   expect_refusal_naming(track_error(r, other), "tracker_state.txt: the interrupted run tracked input=");
   EXPECT_NE(track_error(r, other).find("every=1 stimulus=none; this one input="), std::string::npos);
+  // So would another first frame: --frames 0:4, then 100:110 --resume.
+  other = again;
+  other.range.first = 3;
+  EXPECT_NE(track_error(r, other).find("from=0 every=1 stimulus=none; this one input="), std::string::npos);
   EXPECT_EQ(read_text(csv), csv_text);
   EXPECT_EQ(track_error(r, again), "");
   EXPECT_EQ(valid_rows(csv), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));

@@ -348,7 +348,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // (Control characters escaped, so that any path fits on the state's line.)
   const std::string run =
       shown("input=" + (options.input.rfind("camera:", 0) == 0 ? options.input : absolute(options.input)) +
-                " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
+                " from=" + std::to_string(range.first) + " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
                 (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")) +
                 (options.follow_stimulus ? " followed" : ""),
             1 << 16);
@@ -357,8 +357,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (!resumed->run.empty() && resumed->run != run) {
       throw InputError(state_file.string() + ": the interrupted run tracked " + shown(resumed->run, 300) +
                        "; this one " + shown(run, 300) +
-                       "; cannot resume (give the same --input, --every and --stimulus, or another --out; a run that followed its "
-                       "stimulus log cannot be resumed)");
+                       "; cannot resume (give the same --input, first frame of --frames, --every and --stimulus, or another "
+                       "--out; a run that followed its stimulus log cannot be resumed)");
     }
     detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root);
     const int every = std::max(1, range.every);
