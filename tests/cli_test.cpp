@@ -517,7 +517,7 @@ TEST(Cli, AnOutputIsNeverAnInputNorAnotherOutput) {
   if (fs::exists("/dev/full")) {
     r = gtrack(eval + "--json /dev/full");
     EXPECT_EQ(r.code, 1) << r.output;
-    EXPECT_NE(r.output.find("/dev/full: write failed"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("/dev/full: write failed (No space left on device)"), std::string::npos) << r.output;
   }
 }
 

@@ -395,6 +395,25 @@ TEST(Fault, AnInputThatFailsAtOnceLeavesTheEarlierRun) {
   EXPECT_EQ(read_text(o.out_dir / "summary.json"), summary);
 }
 
+// A file the run cannot write is named as the run's file, not its
+// stand-in (FILE.tmp, renamed over it), with the system's reason; the
+// frames before are kept.
+TEST(Fault, AStateThatCannotBeWrittenIsNamedWithTheReason) {
+  const fs::path dir = fresh_dir("state_unwritable");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, 3);
+  fs::create_directories(o.out_dir / "tracker_state.txt.tmp");  // in the way, as a full disk would be
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    ADD_FAILURE() << "the run went on without its state";
+  } catch (const gtrack::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind((o.out_dir / "tracker_state.txt").string() + ": cannot open for writing (Is a directory)", 0),
+              0u)
+        << what;
+  }
+}
+
 // A second run into a folder another run is writing is refused, naming the
 // other's pid: two runs had written each other's rows into the same files.
 TEST(Fault, ASecondRunIntoABusyFolderIsRefused) {

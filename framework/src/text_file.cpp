@@ -1,5 +1,7 @@
 #include "gtrack/text_file.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 
 #include "gtrack/error.hpp"
@@ -48,11 +50,14 @@ std::string read_text_file(const std::filesystem::path& file, std::size_t max_by
 }
 
 void write_text_file(const std::filesystem::path& file, const std::string& text) {
+  errno = 0;
   std::ofstream out(file, std::ios::trunc | std::ios::binary);
-  if (!out) throw InputError(file.string() + ": cannot open for writing");
+  if (!out) throw InputError(file.string() + ": cannot open for writing (" + write_failure_reason() + ")");
   out << text;
   out.flush();  // a full disk shows when the buffer goes out
-  if (!out) throw InputError(file.string() + ": write failed");
+  if (!out) throw InputError(file.string() + ": write failed (" + write_failure_reason() + ")");
 }
+
+std::string write_failure_reason() { return errno != 0 ? std::strerror(errno) : "disk full?"; }
 
 }  // namespace gtrack

@@ -28,7 +28,12 @@ GTRACK_API std::string read_text_file(const std::filesystem::path& file, std::si
                                       const std::string& expected);
 
 // `text` as the whole of `file`, flushed and checked: a file that cannot be
-// opened or written (a missing folder, a full disk) is an InputError naming it.
+// opened or written (a missing folder, a full disk) is an InputError naming it
+// and the system's reason (write_failure_reason).
 GTRACK_API void write_text_file(const std::filesystem::path& file, const std::string& text);
+
+// Why the write that just failed did: errno's text ("No space left on
+// device"), or "disk full?" when the stream left errno unset.
+GTRACK_API std::string write_failure_reason();
 
 }  // namespace gtrack

@@ -31,10 +31,13 @@ inline void replace_file(const std::filesystem::path& file, const std::string& t
   const std::filesystem::path tmp = file.string() + ".tmp";
   try {
     write_text_file(tmp, text);
-  } catch (const InputError&) {
+  } catch (const InputError& e) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);  // no half-written file is left behind
-    throw;
+    // Said of the file the run writes, not of its stand-in.
+    std::string what = e.what();
+    if (what.rfind(tmp.string(), 0) == 0) what.replace(0, tmp.string().size(), file.string());
+    throw InputError(what);
   }
   if (durable) sync_to_disk(tmp);
   std::error_code ec;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -44,8 +45,9 @@ std::string json_string(const std::string& text) {
 }
 
 std::ofstream open_for_writing(const fs::path& p, bool append) {
+  errno = 0;
   std::ofstream out(p, append ? std::ios::app : std::ios::trunc);
-  if (!out) throw InputError(p.string() + ": cannot open for writing");
+  if (!out) throw InputError(p.string() + ": cannot open for writing (" + write_failure_reason() + ")");
   return out;
 }
 
@@ -93,7 +95,7 @@ ResultWriter::ResultWriter(const fs::path& out_dir, int fingers, bool append) : 
   jsonl_ = open_for_writing(out_dir / "estimates.jsonl", append);
   if (!append) csv_ << csv_header(fingers) << '\n';
   csv_.flush();
-  if (!csv_) throw InputError((out_dir / "estimates.csv").string() + ": write failed");
+  if (!csv_) throw InputError((out_dir / "estimates.csv").string() + ": write failed (" + write_failure_reason() + ")");
 }
 
 void ResultWriter::write(const Estimate& e) {
@@ -106,7 +108,9 @@ void ResultWriter::write(const Estimate& e) {
 
   jsonl_ << estimate_json(e) << '\n';
   jsonl_.flush();
-  if (!csv_ || !jsonl_) throw InputError(dir_.string() + ": writing the estimates failed (disk full?)");
+  if (!csv_ || !jsonl_) {
+    throw InputError(dir_.string() + ": writing the estimates failed (" + write_failure_reason() + ")");
+  }
 }
 
 void ResultWriter::sync() {
