@@ -720,7 +720,7 @@ TEST(Fault, DiskFullMidRunStopsWithOneLine) {
   o.input = write_frames(dir / "frames", kFrames).string();
   o.out_dir = out;
   o.progress = false;
-  expect_refusal_naming(track_error(r, o), "disk full");
+  expect_refusal_naming(track_error(r, o), "writing the estimates failed (No space left on device)");
   // The CSV row of the frame whose JSON line failed is already flushed.
   EXPECT_LE(valid_rows(out / "estimates.csv").size(), 1u);
 }
@@ -1334,7 +1334,7 @@ TEST(TextFile, BoundsAndFailedWritesAreOneLineErrors) {
       gtrack::write_text_file("/dev/full", std::string(1 << 16, 'x'));
       FAIL() << "a full disk must throw";
     } catch (const gtrack::InputError& e) {
-      EXPECT_STREQ(e.what(), "/dev/full: write failed");
+      EXPECT_STREQ(e.what(), "/dev/full: write failed (No space left on device)");
     }
   }
   fs::remove_all(dir);
