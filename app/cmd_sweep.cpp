@@ -242,6 +242,7 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
     so.plugin_paths = c.common.plugin_paths;
     const gtrack::Setup setup = gtrack::load_setup(c.config, so);
     (void)gtrack::engine_config(setup);
+    gtrack::check_root_keys(setup);
   }
   gtrack::cli::make_output_folder(c.out, "out");
 

@@ -36,6 +36,10 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::SetupOptions so;
   so.plugin_paths = common.plugin_paths;
   gtrack::Setup setup = gtrack::load_setup(config, so);
+  // Checked as track checks it: sequence.toml carries the engine's tables,
+  // and its `track it:` line must not fail on them.
+  (void)gtrack::engine_config(setup);
+  gtrack::check_root_keys(setup);
   // A config given without --preset: the preset whose config it is, else
   // the one whose config names the same gripper plugin (a lab's own copy
   // of a shipped config), else one of the look the config segments (grey

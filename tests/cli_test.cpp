@@ -917,6 +917,21 @@ TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
       << r.output;
 }
 
+// synth checks the engine's tables as track does, before anything is
+// drawn: its sequence.toml carries them, and its `track it:` line failed.
+TEST(Cli, SynthChecksTheEnginesTablesFirst) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_engine";
+  fs::remove_all(dir);
+  const fs::path zero = write("synth_engine_zero.toml", hydrogel_config() + "\n[pso]\nparticles = 0\n");
+  CliRun r = gtrack("synth --config " + zero.string() + " --frames 1 --out " + dir.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("key 'pso.particles': value 0 is out of range"), std::string::npos) << r.output;
+  const fs::path typo = write("synth_engine_typo.toml", hydrogel_config() + "\n[pso]\npartcles = 10\n");
+  r = gtrack("synth --config " + typo.string() + " --frames 1 --out " + dir.string());
+  EXPECT_NE(r.output.find("key 'pso.partcles': unknown key in [pso]"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
 TEST(Cli, SynthKeepsTheConfigsFilesAndReadsAPipeOnce) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_files";
   fs::remove_all(dir);
