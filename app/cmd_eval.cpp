@@ -165,7 +165,8 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
 
 // The run that wrote the estimates kept its config beside them (a two-pass
 // table: in the run's folder's two_pass/ or backward/): a sensor posed or
-// sized otherwise there splits the errors along other axes than the run's.
+// sized otherwise there splits the errors along other axes than the run's,
+// and another gripper model measures its endpoints on another shape.
 void warn_if_the_run_imaged_otherwise(const fs::path& estimates_file, const fs::path& config,
                                       const gtrack::Setup& setup, const gtrack::SetupOptions& so) {
   std::error_code ec;
@@ -173,6 +174,7 @@ void warn_if_the_run_imaged_otherwise(const fs::path& estimates_file, const fs::
   if (!fs::is_regular_file(run_config, ec)) run_config = estimates_file.parent_path().parent_path() / "run_config.toml";
   if (!fs::is_regular_file(run_config, ec) || fs::equivalent(run_config, config, ec)) return;
   std::optional<gtrack::Projection> ran;
+  std::optional<gtrack::Setup> run;
   {
     // What loading it says was said when it ran.
     struct Quiet {
@@ -181,7 +183,8 @@ void warn_if_the_run_imaged_otherwise(const fs::path& estimates_file, const fs::
       ~Quiet() { gtrack::logger().set_level(level); }
     } quiet;
     try {
-      ran = gtrack::load_setup(run_config, so).sensor->projection();
+      run = gtrack::load_setup(run_config, so);
+      ran = run->sensor->projection();
     } catch (const std::exception&) {
       return;  // a run config this machine cannot load (its plugins elsewhere) is no evidence either way
     }
@@ -192,6 +195,22 @@ void warn_if_the_run_imaged_otherwise(const fs::path& estimates_file, const fs::
     gtrack::logger().warn("{}: its [sensor] images the world otherwise than {}'s (a sensor posed or sized "
                           "otherwise): the errors are measured along {}'s axes, and the in-view shares from it",
                           run_config.string(), config.string(), config.string());
+  }
+  // The same shape: the same link endpoints at a pose with every joint half
+  // folded.
+  const gtrack::ArticulatedModel &a = run->model(), &b = setup.model();
+  bool same = a.dims() == b.dims();
+  if (same) {
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(a.dims());
+    h[2] = 100;
+    h.tail(a.fingers()).setConstant(30);
+    const auto ea = a.link_endpoints(h), eb = b.link_endpoints(h);
+    same = ea.size() == eb.size();
+    for (size_t i = 0; same && i < ea.size(); ++i) same = (ea[i] - eb[i]).norm() < 1e-6;
+  }
+  if (!same) {
+    gtrack::logger().warn("{}: its gripper model ('{}') differs from {}'s ('{}'): the errors are measured on {}'s",
+                          run_config.string(), a.geometry().name, config.string(), b.geometry().name, config.string());
   }
 }
 
@@ -217,6 +236,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   fs::path config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
                                        : truth_file.parent_path() / "sequence.toml";
   if (!fs::exists(config)) {
+    if (vm.count("config")) throw gtrack::InputError(config.string() + ": no such file (--config)");
     throw gtrack::cli::UsageError("no --config given and no " + config.string() +
                                   " next to the truth; the config names the gripper model");
   }

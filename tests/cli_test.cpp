@@ -596,6 +596,19 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   r = gtrack(eval);
   EXPECT_NE(r.output.find("run_config.toml: its [sensor] images the world otherwise than"), std::string::npos)
       << r.output;
+  EXPECT_EQ(r.output.find("its gripper model"), std::string::npos) << r.output;
+  // With another gripper (its links longer): said too.
+  {
+    std::string text = read_file(dir / "sequence.toml");
+    text = replaced(text, "[gripper]\n", "[gripper]\nlink_lengths_mm = [0.4, 0.4, 0.4, 0.3]\n");
+    std::ofstream(dir / "run" / "run_config.toml") << text;
+  }
+  r = gtrack(eval);
+  EXPECT_NE(r.output.find("run_config.toml: its gripper model ('hydrogel_six_finger') differs from"), std::string::npos)
+      << r.output;
+  // A --config that does not exist is said to be missing.
+  r = gtrack(eval + " --config " + (dir / "nowhere.toml").string());
+  EXPECT_NE(r.output.find("nowhere.toml: no such file (--config)"), std::string::npos) << r.output;
 }
 
 TEST(Cli, EvalRefusesMalformedTables) {
