@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
     std::cerr << "gtrack: error: " << gtrack::shown(e.what()) << "\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "gtrack: error: " << gtrack::shown(e.what()) << "\n";
+    std::cerr << "gtrack: error: " << gtrack::shown(gtrack::library_words(e.what())) << "\n";
     return 1;
   }
 }

@@ -1299,6 +1299,21 @@ TEST(Fault, NonFiniteParameterVectorIsOneLine) {
 
 // The readers' and writers' shared checks: a line and a file have a bound, a
 // write is checked after its buffer went out.
+// A library's words in a message: OpenCV's source location and function,
+// and FFmpeg's pointers, are left out; what it says is kept.
+TEST(TextFile, LibraryWordsKeepWhatTheLibrarySaid) {
+  EXPECT_EQ(gtrack::library_words("OpenCV(4.6.0) ./modules/core/src/alloc.cpp:73: error: (-4:Insufficient memory) "
+                                  "Failed to allocate 4294967296 bytes in function 'OutOfMemoryError'\n"),
+            "Failed to allocate 4294967296 bytes");
+  EXPECT_EQ(gtrack::library_words("imreadmulti_('a.tif'): can't read data: OpenCV(4.6.0) "
+                                  "./modules/imgcodecs/src/grfmt_tiff.cpp:704: error: (-2:Unspecified error) OpenCV "
+                                  "TIFF: failed TIFFReadRGBAStrip(...) in function 'readData'"),
+            "imreadmulti_('a.tif'): can't read data: OpenCV TIFF: failed TIFFReadRGBAStrip(...)");
+  EXPECT_EQ(gtrack::library_words("[mjpeg @ 0x563318912a40] overread 8; [h264 @ 0x55d0] error while decoding"),
+            "mjpeg: overread 8; h264: error while decoding");
+  EXPECT_EQ(gtrack::library_words("libpng error: Read Error"), "libpng error: Read Error");
+}
+
 TEST(TextFile, BoundsAndFailedWritesAreOneLineErrors) {
   std::istringstream three("ab\n\nlast");
   std::string line;

@@ -10,6 +10,8 @@
 #include <mutex>
 #include <string>
 
+#include "gtrack/error.hpp"
+
 namespace gtrack::detail {
 
 class CapturedStderr {
@@ -45,6 +47,7 @@ class CapturedStderr {
         line += c;
       }
     }
+    line = library_words(line);
     while (!line.empty() && (line.back() == ' ' || line.back() == ';')) line.pop_back();
     if (line.size() > 300) line = line.substr(0, 297) + "...";
     return line;
