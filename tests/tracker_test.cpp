@@ -1036,6 +1036,17 @@ TEST(EngineConfig, ExcludedRectanglesAreWholePixelsWithinTheImage) {
             std::string::npos);
 }
 
+// [render] egl_device's form is checked with the config, naming its key:
+// the gl backend's own message named a C++ member.
+TEST(EngineConfig, TheEglDeviceIsAnIndexOrSurfaceless) {
+  for (const char* good : {"\"\"", "\"0\"", "\"12\"", "\"surfaceless\""}) {
+    EXPECT_NO_THROW(gtrack::engine_config(make_setup(std::string("[render]\negl_device = ") + good + "\n"))) << good;
+  }
+  const std::string m = engine_config_error("[render]\negl_device = \"foo\"\n");
+  EXPECT_NE(m.find("key 'render.egl_device': 'foo'; expected a device index"), std::string::npos) << m;
+  EXPECT_NE(engine_config_error("[render]\negl_device = \"-1\"\n").find("egl_device"), std::string::npos);
+}
+
 TEST(EngineConfig, PaperDefaults) {
   auto setup = make_setup();
   const auto c = gtrack::engine_config(setup);

@@ -104,6 +104,12 @@ RenderOptions read_render(const ConfigTable& t, const Sensor& sensor) {
   }
   r.threads = static_cast<int>(t.integer_or("threads", r.threads, Range::closed(0, 1024)));
   r.egl_device = t.string_or("egl_device", r.egl_device);
+  // Whether the device exists is the gl backend's to say; the form is known here.
+  const std::string& d = r.egl_device;
+  if (!(d.empty() || d == "surfaceless" ||
+        (d.size() <= 6 && std::all_of(d.begin(), d.end(), [](char c) { return c >= '0' && c <= '9'; })))) {
+    t.fail("egl_device", "'" + shown(d, 60) + "'; expected a device index (0, 1, ...), \"surfaceless\" or \"\" (any)");
+  }
   return r;
 }
 
