@@ -1039,12 +1039,23 @@ TEST(EngineConfig, ExcludedRectanglesAreWholePixelsWithinTheImage) {
 // [render] egl_device's form is checked with the config, naming its key:
 // the gl backend's own message named a C++ member.
 TEST(EngineConfig, TheEglDeviceIsAnIndexOrSurfaceless) {
+  const auto config = [](const std::string& device) {
+    std::string text = kConfig;
+    text.replace(text.find("threads = 2\n"), 12, "threads = 2\negl_device = " + device + "\n");
+    return gtrack::engine_config(gtrack::load_setup(gtrack::ConfigTable::parse(text, "<test>"), {}));
+  };
   for (const char* good : {"\"\"", "\"0\"", "\"12\"", "\"surfaceless\""}) {
-    EXPECT_NO_THROW(gtrack::engine_config(make_setup(std::string("[render]\negl_device = ") + good + "\n"))) << good;
+    EXPECT_NO_THROW(config(good)) << good;
   }
-  const std::string m = engine_config_error("[render]\negl_device = \"foo\"\n");
-  EXPECT_NE(m.find("key 'render.egl_device': 'foo'; expected a device index"), std::string::npos) << m;
-  EXPECT_NE(engine_config_error("[render]\negl_device = \"-1\"\n").find("egl_device"), std::string::npos);
+  for (const char* bad : {"\"foo\"", "\"-1\""}) {
+    try {
+      config(bad);
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const gtrack::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("key 'render.egl_device': '"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("expected a device index (0, 1, ...)"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(EngineConfig, PaperDefaults) {
