@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
-  const fs::path out = vm["out"].as<std::string>();
+  const fs::path out = gtrack::cli::out_folder(vm);
   gtrack::SynthOptions so;
   so.frames = vm["frames"].as<int>();
   so.seed = gtrack::cli::seed_option(vm);

@@ -197,7 +197,7 @@ const char* kColumns =
 int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   Context c;
   c.common = common;
-  c.out = vm["out"].as<std::string>();
+  c.out = gtrack::cli::out_folder(vm);
   c.synth.frames = vm["frames"].as<int>();
   c.synth.seed = gtrack::cli::seed_option(vm);
   c.synth.preset = vm["preset"].as<std::string>();

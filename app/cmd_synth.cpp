@@ -72,7 +72,7 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
                           o.preset, grey_frames ? "grey-level" : "colour", config.string(),
                           grey_look ? "grey levels" : "colour");
   }
-  const std::filesystem::path out = vm["out"].as<std::string>();
+  const std::filesystem::path out = gtrack::cli::out_folder(vm);
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
   std::string unit;
   if (setup.stimulus && !setup.stimulus->reading_unit().empty()) unit = " " + setup.stimulus->reading_unit();

@@ -55,7 +55,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::TrackOptions opt;
   opt.input = vm["input"].as<std::string>();
   if (vm.count("stimulus")) opt.stimulus_csv = vm["stimulus"].as<std::string>();
-  opt.out_dir = vm["out"].as<std::string>();
+  opt.out_dir = gtrack::cli::out_folder(vm);
   opt.range = gtrack::cli::frame_range_option(vm);
   opt.save_masks = vm.count("save-masks") > 0;
   if (vm.count("no-overlay")) opt.overlay = false;

@@ -101,6 +101,14 @@ inline void check_outputs_apart(const NamedPaths& outputs, const NamedPaths& inp
   }
 }
 
+// --out, the folder a command writes into: an empty one would be the
+// working folder, written over without a word.
+inline std::filesystem::path out_folder(const boost::program_options::variables_map& vm) {
+  const std::string out = vm["out"].as<std::string>();
+  if (out.empty()) throw UsageError("--out is empty; expected a folder");
+  return out;
+}
+
 // A folder to write into, made if missing: a path under a regular file or
 // one that cannot be made is one line naming it.
 inline void make_output_folder(const std::filesystem::path& dir, const std::string& option = "") {

@@ -945,6 +945,17 @@ TEST(Cli, SynthChecksTheEnginesTablesFirst) {
   EXPECT_FALSE(fs::exists(dir));
 }
 
+// An empty --out would be the working folder, written over without a word.
+TEST(Cli, AnEmptyOutIsRefused) {
+  const fs::path cfg = write("empty_out.toml", hydrogel_config());
+  for (const std::string& args : std::vector<std::string>{"demo --out ''", "synth --frames 1 --out ''", "sweep --out ''",
+                                                          "track --config " + cfg.string() + " --input x --out ''"}) {
+    const CliRun r = gtrack(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.output.find("--out is empty; expected a folder"), std::string::npos) << args << ": " << r.output;
+  }
+}
+
 TEST(Cli, SynthKeepsTheConfigsFilesAndReadsAPipeOnce) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "synth_files";
   fs::remove_all(dir);
