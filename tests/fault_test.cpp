@@ -328,6 +328,18 @@ TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
                               "to 255, value 0 to 255): the frame is lost";
   EXPECT_NE(empty_log.find(nothing), std::string::npos) << empty_log;
   EXPECT_EQ(empty_log.find("no pixel"), empty_log.rfind("no pixel")) << "said once: " << empty_log;
+  // Bounds that would find it, but exclude_px over the whole image: said.
+  r.config.observation.hue_min = 0;
+  r.config.observation.hue_max = 180;
+  r.config.observation.exclude_px = {cv::Rect(0, 0, kSide, kSide)};
+  const std::string excluded_log = warnings_of(plain, dir / "out_excluded");
+  EXPECT_NE(excluded_log.find("value 0 to 255), outside [observation] exclude_px's 1 rectangle (100 % of the "
+                              "image): the frame is lost"),
+            std::string::npos)
+      << excluded_log;
+  r.config.observation.exclude_px.clear();
+  r.config.observation.hue_min = 100;
+  r.config.observation.hue_max = 130;
   // A dark gripper on a light background, segmented for bright pixels.
   r.config.observation.color_space = "luminance";
   fs::create_directories(dir / "bright_field");

@@ -184,9 +184,9 @@ class ObservationAdvice {
     if (!said_grey_ && (first || e.observed_pixels == 0)) said_grey_ = grey_for_colour(frame, first);
     if (!said_empty_ && !seen_any_ && e.observed_pixels == 0 && !said_grey_ && !uniform(frame.image)) {
       said_empty_ = true;
-      logger().warn("{}: no pixel within the [observation] bounds ({}): the frame is lost, as every frame will be "
+      logger().warn("{}: no pixel within the [observation] bounds ({}){}: the frame is lost, as every frame will be "
                     "until the gripper shows; if it is in view, check the bounds on this recording with --save-masks",
-                    frame.name, bounds());
+                    frame.name, bounds(), excluded(frame.image.size()));
     }
     seen_any_ = seen_any_ || e.observed_pixels > 0;
     const double share = observation.mask.empty() ? 0.0 : double(e.observed_pixels) / observation.mask.total();
@@ -216,6 +216,17 @@ class ObservationAdvice {
     }
     return fmt::format("hue {:g} to {:g}, saturation {:g} to {:g}, value {:g} to {:g}", o_.hue_min, o_.hue_max,
                        o_.saturation_min, o_.saturation_max, o_.value_min, o_.value_max);
+  }
+
+  // ", outside [observation] exclude_px's 2 rectangles (98 % of the image)",
+  // when rectangles are excluded: they may be what hides everything.
+  std::string excluded(const cv::Size& image) const {
+    if (o_.exclude_px.empty()) return "";
+    cv::Mat covered = cv::Mat::zeros(image, CV_8U);
+    for (const cv::Rect& r : o_.exclude_px) covered(r & cv::Rect({}, image)).setTo(1);
+    const size_t n = o_.exclude_px.size();
+    return fmt::format(", outside [observation] exclude_px's {} rectangle{} ({:.0f} % of the image)", n,
+                       n == 1 ? "" : "s", 100.0 * cv::countNonZero(covered) / covered.total());
   }
 
   bool grey_for_colour(const Frame& frame, bool first) const {
