@@ -374,6 +374,12 @@ TEST(Synth, SynthTableErrorsNameTheKeyAndLeaveTheFolderAlone) {
   EXPECT_NE(empty.find("synth.stimulus_high"), std::string::npos) << empty;
   EXPECT_NE(empty.find("greater than stimulus_low"), std::string::npos) << empty;
   EXPECT_NE(message("stimulus_period_s = 0\n").find("synth.stimulus_period_s"), std::string::npos);
+  // Readings the stimulus plugin refuses (a profile in kelvin), by their key,
+  // however few frames would reach them.
+  const std::string kelvin = message("stimulus_low = 295.0\nstimulus_high = 305.0\n");
+  EXPECT_NE(kelvin.find("key 'synth.stimulus_low': a reading of 295"), std::string::npos) << kelvin;
+  const std::string noise = message("stimulus_noise = 1e9\n");
+  EXPECT_NE(noise.find("key 'synth.stimulus_noise': a reading of"), std::string::npos) << noise;
   EXPECT_FALSE(fs::exists(dir));
 }
 

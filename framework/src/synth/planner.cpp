@@ -175,6 +175,20 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   // The material's response, from a stimulus instance of our own so that
   // the setup's (the tracker's) stays untouched.
   auto stimulus = setup.loader->make_stimulus(setup.root.table("stimulus"));
+  // The profile's ends are readings the plugin must take (a temperature in
+  // kelvin is refused), said of their [synth] keys; so is the noise that
+  // takes a reading past them.
+  const ConfigTable& synth_table = setup.root.table("synth");
+  {
+    auto probe = setup.loader->make_stimulus(setup.root.table("stimulus"));
+    for (const auto& [key, value] : {std::pair{"stimulus_low", p.stimulus_low}, {"stimulus_high", p.stimulus_high}}) {
+      try {
+        probe->update(value, 0);
+      } catch (const std::exception& e) {
+        synth_table.fail(key, e.what());
+      }
+    }
+  }
   const int F = model.fingers(), L = model.max_links();
   std::vector<double> lag(F), q(F, model.geometry().unfolded_deg);
   for (int f = 0; f < F; ++f) lag[f] = p.joint_lag_s * (1 + p.joint_lag_spread * (2 * u(rng) - 1));
@@ -205,7 +219,12 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
     h[5] = std::remainder(rz, 360.0);
     h = frame.to_world(h);
 
-    stimulus->update(temperature[i], t);
+    try {
+      stimulus->update(temperature[i], t);
+    } catch (const std::exception& e) {
+      synth_table.fail("stimulus_noise", std::string(e.what()) + " (frame " + std::to_string(i) +
+                                             ": the profile with its noise)");
+    }
     if (i > 0) {
       for (int f = 0; f < F; ++f) {
         const double target = stimulus->target_joint_deg(q[f]);
