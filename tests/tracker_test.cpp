@@ -20,6 +20,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
 #include "gtrack/model.hpp"
+#include "gtrack/results.hpp"
 #include "gtrack/synth.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/tracker_state.hpp"
@@ -408,6 +409,17 @@ TEST(Tracker, SameSeedSameEstimates) {
   a.set_estimate(pose(0.12, 0.08, 12, 8));
   b.set_estimate(pose(0.12, 0.08, 12, 8));
   EXPECT_EQ(a.process(frame, 4, 0.1, 23.0).hypothesis, b.process(frame, 4, 0.1, 23.0).hypothesis);
+}
+
+// JSON is UTF-8: an image name that is not (Latin-1 bytes) is written with
+// those bytes as \u00XX, and a UTF-8 one as it is; a consumer's parser had
+// failed on the raw bytes.
+TEST(Results, AnImageNameThatIsNotUtf8IsStillJson) {
+  gtrack::Estimate e;
+  e.hypothesis = Eigen::VectorXd::Zero(12);
+  e.image = "caf\xc3\xa9_\xff\xfe\xed\xa0\x80.png";  // é, two Latin-1 bytes, an encoded surrogate
+  const std::string j = gtrack::estimate_json(e);
+  EXPECT_NE(j.find("\"image\":\"caf\xc3\xa9_\\u00ff\\u00fe\\u00ed\\u00a0\\u0080.png\""), std::string::npos) << j;
 }
 
 TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {

@@ -26,20 +26,44 @@ std::string num(double v, const char* fmt) {
   return buf;
 }
 
+// The length of the well-formed UTF-8 sequence at text[i] (1 to 4), or 0.
+size_t utf8_length(const std::string& text, size_t i) {
+  const auto at = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char c = at(i);
+  const size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+  if (n == 0 || i + n > text.size()) return 0;
+  for (size_t k = 1; k < n; ++k) {
+    if ((at(i + k) & 0xC0) != 0x80) return 0;
+  }
+  // Overlong forms, surrogates and code points past U+10FFFF are not UTF-8.
+  if ((n == 2 && c < 0xC2) || (n == 3 && c == 0xE0 && at(i + 1) < 0xA0) || (n == 3 && c == 0xED && at(i + 1) >= 0xA0) ||
+      (n == 4 && c == 0xF0 && at(i + 1) < 0x90) || (n == 4 && (c > 0xF4 || (c == 0xF4 && at(i + 1) >= 0x90)))) {
+    return 0;
+  }
+  return n;
+}
+
 // A JSON string literal of free text (a decoder's message, a file name).
+// JSON is UTF-8: a byte that is not (a file name in Latin-1) is written as
+// the code point of the same number, \u00XX.
 std::string json_string(const std::string& text) {
   std::string s = "\"";
-  for (const char c : text) {
+  for (size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    const size_t n = utf8_length(text, i);
     if (c == '"' || c == '\\') {
       s += '\\';
       s += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
+    } else if (n == 0 || static_cast<unsigned char>(c) < 0x20) {
       char buf[8];
       std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
       s += buf;
     } else {
-      s += c;
+      s.append(text, i, n);
+      i += n;
+      continue;
     }
+    ++i;
   }
   return s + "\"";
 }
