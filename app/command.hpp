@@ -132,7 +132,13 @@ inline void backend_option(const boost::program_options::variables_map& vm, std:
 // --frames and --every (a command that declares both).
 inline FrameRange frame_range_option(const boost::program_options::variables_map& vm) {
   FrameRange range;
-  if (vm.count("frames")) range = parse_frame_range(vm["frames"].as<std::string>());
+  if (vm.count("frames")) {
+    try {
+      range = parse_frame_range(vm["frames"].as<std::string>());
+    } catch (const InputError& e) {
+      throw UsageError(e.what());  // an option, not an input: exit status 2, as the others
+    }
+  }
   range.every = vm["every"].as<int>();
   if (range.every < 1) throw UsageError("--every must be at least 1");
   return range;

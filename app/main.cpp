@@ -152,7 +152,11 @@ int run(int argc, char** argv) {
 
   gtrack::cli::CommonOptions common;
   common.log_level = vm["log-level"].as<std::string>();
-  gtrack::set_log_level(common.log_level);
+  try {
+    gtrack::set_log_level(common.log_level);
+  } catch (const gtrack::Error& e) {
+    throw gtrack::cli::UsageError(e.what());
+  }
   if (vm.count("plugin-path")) {
     for (const auto& p : vm["plugin-path"].as<std::vector<std::string>>()) common.plugin_paths.emplace_back(p);
   }

@@ -945,6 +945,18 @@ TEST(Cli, SynthChecksTheEnginesTablesFirst) {
   EXPECT_FALSE(fs::exists(dir));
 }
 
+// A malformed option value is a usage error (exit status 2), whichever
+// option: --frames and --log-level had exited 1, as an input error does.
+TEST(Cli, AMalformedOptionIsAUsageError) {
+  const fs::path cfg = write("usage_codes.toml", hydrogel_config());
+  for (const std::string& args : std::vector<std::string>{"track --config " + cfg.string() + " --input x --out y --frames abc",
+                                                          "track --config " + cfg.string() + " --input x --out y --every 0",
+                                                          "plugins --log-level loud"}) {
+    const CliRun r = gtrack(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+  }
+}
+
 // An empty --out would be the working folder, written over without a word.
 TEST(Cli, AnEmptyOutIsRefused) {
   const fs::path cfg = write("empty_out.toml", hydrogel_config());
