@@ -130,7 +130,9 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     }
   }
   if (!have_occlusion) {
-    std::cout << "  breakdown: the truth has no 'occluded' column (gtrack synth writes one)\n";
+    const bool column = !truth.rows.empty() && truth.rows.front().extra.count("occluded");
+    std::cout << (column ? "  breakdown: no frame in view has a usable estimate\n"
+                         : "  breakdown: the truth has no 'occluded' column (gtrack synth writes one)\n");
     return;
   }
   std::cout << "  breakdown (in-view frames with an estimate; the allowance rows need estimates.jsonl, the last "
