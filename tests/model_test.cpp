@@ -130,6 +130,14 @@ TEST(HydrogelModel, ConfigOverridesAreValidated) {
               std::string::npos)
         << e.what();
   }
+  // A link 0 wide at both ends is named by the widths' key, not the plugin.
+  try {
+    make_gripper("plugin = \"hydrogel_six_finger\"\nlink_widths_mm = [0.3, 0, 0, 0, 0]");
+    ADD_FAILURE() << "links without width were accepted";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'link_widths_mm': link 2 is 0 wide at both ends"), std::string::npos)
+        << e.what();
+  }
   auto g = make_gripper("plugin = \"hydrogel_six_finger\"\nlink_lengths_mm = [0.5, 0.5]\nlink_widths_mm = [0.5, 0.4, 0]");
   EXPECT_EQ(g->model().triangles(), 4 + 6 * 3);
 }
