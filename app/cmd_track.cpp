@@ -29,9 +29,26 @@ std::atomic<bool> g_reader_gone{false};  // --stream: stdout's reader closed the
 // session closes, unless run under `nohup`) lets the current frame finish
 // and the files close; the handler then reverts to the default, so a second
 // one ends the process.
-extern "C" void on_sigint(int) { g_stop.store(true); }
+// --stream: a reader that has stopped reading leaves a write blocked, and
+// the run could not reach its next frame to stop. Once interrupted, the
+// write gets kStreamGraceS seconds; then SIGALRM, installed without
+// SA_RESTART, ends it with EINTR and the run stops as when the reader goes.
+constexpr unsigned kStreamGraceS = 5;
+std::atomic<bool> g_streaming{false};
+std::atomic<bool> g_grace_over{false};
+std::atomic<bool> g_stream_stalled{false};  // a write failed after the grace
+extern "C" void on_sigint(int) {
+  g_stop.store(true);
+  if (g_streaming.load()) ::alarm(kStreamGraceS);
+}
+extern "C" void on_alarm(int) { g_grace_over.store(true); }
 
 void install_sigint() {
+  struct sigaction alarm_action {};
+  alarm_action.sa_handler = on_alarm;
+  sigemptyset(&alarm_action.sa_mask);
+  sigaction(SIGALRM, &alarm_action, nullptr);
+
   struct sigaction sa {};
   sa.sa_handler = on_sigint;
   sigemptyset(&sa.sa_mask);
@@ -75,10 +92,11 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     // A reader that goes away (the controller stopped) ends the run like
     // Ctrl-C does, files closed, instead of SIGPIPE killing the process.
     std::signal(SIGPIPE, SIG_IGN);
+    g_streaming = true;
     opt.on_frame = [](const gtrack::Estimate& e) {
-      if (g_reader_gone) return;
+      if (g_reader_gone || g_stream_stalled) return;
       if (std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
-        g_reader_gone = true;
+        (g_grace_over ? g_stream_stalled : g_reader_gone) = true;
         g_stop = true;
       }
     };
@@ -119,11 +137,16 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   }
 
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
+  ::alarm(0);
   // A two-pass run cannot be resumed: its backward pass needs the whole forward run.
   const char* next = two_pass ? " (the same command with --resume instead of --two-pass continues the forward run)"
                      : opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
                                            : " (the same command with --resume continues)";
-  if (s.cancelled && g_reader_gone) {
+  if (s.cancelled && g_stream_stalled) {
+    std::cerr << "gtrack track: interrupted, and the reader of --stream took no line for " << kStreamGraceS
+              << " s; stopped after " << s.frames << (s.frames == 1 ? " frame" : " frames") << ", kept in "
+              << opt.out_dir.string() << next << "\n";
+  } else if (s.cancelled && g_reader_gone) {
     std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames
               << (s.frames == 1 ? " frame" : " frames") << ", kept in "
               << opt.out_dir.string() << next << "\n";

@@ -1,6 +1,7 @@
 // The tracker end to end on small synthetic scenes: coarse search, frame to
 // frame tracking, files written by track_sequence, interruption, bad inputs.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 
 #include <opencv2/imgproc.hpp>
 #include <signal.h>
@@ -551,6 +552,61 @@ static void interrupt_leaves_complete_rows(int signal, const std::string& name, 
 TEST(TrackCommand, SigintLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGINT, "seq_sigint"); }
 TEST(TrackCommand, SighupLeavesCompleteRows) { interrupt_leaves_complete_rows(SIGHUP, "seq_sighup"); }
 TEST(TrackCommand, SighupUnderNohupIsIgnored) { interrupt_leaves_complete_rows(SIGINT, "seq_nohup", true); }
+
+// --stream to a reader that has stopped reading: the run's write blocks
+// once the pipe is full. Interrupted, it stops within a few seconds, files
+// closed and summary written, instead of waiting for the reader forever.
+TEST(TrackCommand, SigintWithAStalledStreamReaderStops) {
+  const fs::path seq = write_sequence("seq_stalled", 300);
+  const fs::path cfg = seq / "config.toml";
+  std::ofstream(cfg) << kConfig;
+  const fs::path out = seq / "out", err = seq / "err.txt";
+  const std::string exe = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack";
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::dup2(pipe_fds[1], STDOUT_FILENO);
+    ::close(pipe_fds[0]);
+    const int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(e, STDERR_FILENO);
+    const std::string input = (seq / "frames").string(), outs = out.string(), cfgs = cfg.string();
+    execl(exe.c_str(), exe.c_str(), "track", "--config", cfgs.c_str(), "--input", input.c_str(), "--out", outs.c_str(),
+          "--stream", "--no-overlay", "--log-level", "warn", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  ::close(pipe_fds[1]);  // the pipe is never read: it fills, and the run's write blocks
+  // Wait until the rows stop growing: the write is blocked.
+  size_t rows = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (;;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const size_t now = lines(out / "estimates.csv").size();
+    if ((now == rows && now > 1) || std::chrono::steady_clock::now() - t0 > std::chrono::seconds(60)) break;
+    rows = now;
+  }
+  ASSERT_LT(rows, 301u) << "the run ended before its stream's pipe filled";
+  kill(pid, SIGINT);
+  int status = 0;
+  const auto t1 = std::chrono::steady_clock::now();
+  while (waitpid(pid, &status, WNOHANG) == 0 && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(30)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const bool stopped = std::chrono::steady_clock::now() - t1 < std::chrono::seconds(30);
+  if (!stopped) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+  }
+  ::close(pipe_fds[0]);
+  ASSERT_TRUE(stopped) << "the run did not stop";
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  std::ifstream in(err);
+  const std::string said((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(said.find("interrupted, and the reader of --stream took no line for 5 s"), std::string::npos) << said;
+}
 
 // `gtrack synth` stopped part way (Ctrl-C) in the folder of an earlier
 // sequence: the earlier sequence's truth is gone before any new frame is
