@@ -77,10 +77,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A folder of this process's own, removed when it exits.
 fs::path calibration_dir() {
-  const fs::path d = fs::temp_directory_path() / ("gtrack_sensor_test_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
+  static const struct Folder {
+    fs::path path = fs::temp_directory_path() / ("gtrack_sensor_test_" + std::to_string(::getpid()));
+    Folder() { fs::create_directories(path); }
+    ~Folder() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } folder;
+  fs::create_directories(folder.path);
+  return folder.path;
 }
 
 std::string error_of(const std::string& toml, const std::string& source = "<test>") {
