@@ -1042,6 +1042,11 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   const auto lines = std::count(kept_text.begin(), kept_text.end(), '\n');
   expect_refusal_naming(track_error(r, again), "run_config.toml:" + std::to_string(lines + 1) + ": ");
   EXPECT_EQ(read_text(csv), csv_text);
+  // An empty copy (what a power loss can leave) is said to be empty, not
+  // another config.
+  std::ofstream(kept, std::ios::trunc).flush();
+  expect_refusal_naming(track_error(r, again), "run_config.toml: is empty (cut short");
+  EXPECT_EQ(read_text(csv), csv_text);
   std::ofstream(kept) << kept_text;
   TrackRun commented{gtrack::load_setup(gtrack::ConfigTable::parse("# a note\n" + kConfig, "fault.toml"), {}), {}};
   commented.config = gtrack::engine_config(commented.setup);

@@ -184,7 +184,7 @@ ConfigTable load_config(const fs::path& file) {
   return ConfigTable::parse(text, file.string(), base);
 }
 
-void write_run_config(const fs::path& file, const ConfigTable& root) {
+void write_run_config(const fs::path& file, const ConfigTable& root, bool durable) {
   std::string from = root.source();
   from = from.empty() ? std::string("<config>") : from.front() == '<' ? shown(from, 1 << 12, true) : encoded(from);
   // A run's own copy given as the config is copied without its header; a
@@ -208,12 +208,17 @@ void write_run_config(const fs::path& file, const ConfigTable& root) {
     header += std::string(kFileLine) + f.name() + " = " + encoded(f.path) + ": " + fingerprint(f.path) + "\n";
   }
   header += std::string(kPrefix) + "--resume checks that this config, and the files it names, are unchanged\n";
-  replace_file(file, header + text);
+  replace_file(file, header + text, durable);
 }
 
 void check_same_config(const fs::path& file, const ConfigTable& root) {
   std::error_code ec;
   if (!fs::exists(file, ec)) return;
+  if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == 0) {
+    throw InputError(shown(file.string(), 1 << 12) +
+                     ": is empty (cut short, as a power loss can leave it without --durable); cannot resume "
+                     "(run without --resume, or with another --out)");
+  }
   std::optional<ConfigDifference> d;
   try {
     d = first_difference(ConfigTable::load_file(file.string()), root);

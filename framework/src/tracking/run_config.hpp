@@ -34,7 +34,7 @@ ConfigTable load_config(const std::filesystem::path& file);
 
 // Writes the copy of `root` (a copy given as the config is copied without
 // its header) with the files root.named_files() lists.
-void write_run_config(const std::filesystem::path& file, const ConfigTable& root);
+void write_run_config(const std::filesystem::path& file, const ConfigTable& root, bool durable = false);
 
 // Throws InputError, naming the first difference, when `root` is not the
 // config kept in `file`, or a file it names has changed. A run without the

@@ -491,7 +491,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
   }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
-  if (!resumed) detail::write_run_config(options.out_dir / detail::kRunConfigName, setup.root);
+  if (!resumed) detail::write_run_config(options.out_dir / detail::kRunConfigName, setup.root, options.durable);
   if (options.save_masks) {
     std::error_code ec;
     fs::create_directories(options.out_dir / "masks", ec);
