@@ -1,6 +1,9 @@
 // gtrack render: the model as the sensor sees it, as a mask and a posed mesh.
-#include <sstream>
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
 #include <iostream>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "command.hpp"
@@ -56,6 +59,13 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   gtrack::cli::backend_option(vm, ro.backend);
   ro.scale = vm["scale"].as<double>();
   if (!(ro.scale > 0 && ro.scale <= 1)) throw gtrack::cli::UsageError("--scale must be in (0, 1]");
+  // As [render] scale: a mask a few pixels across shows no shape.
+  const gtrack::ImageSize full = setup.sensor->image_size();
+  if (std::min(std::lround(ro.scale * full.width), std::lround(ro.scale * full.height)) < 8) {
+    throw gtrack::cli::UsageError(fmt::format("--scale {:g}", ro.scale) + " renders the " + std::to_string(full.width) +
+                                  "x" + std::to_string(full.height) +
+                                  " image with fewer than 8 pixels on a side; expected a larger scale");
+  }
   auto renderer = gtrack::make_renderer(ro);
   renderer->set_model(model);
   renderer->set_projection(setup.sensor->projection(), ro.scale);

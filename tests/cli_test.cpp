@@ -951,7 +951,10 @@ TEST(Cli, AMalformedOptionIsAUsageError) {
   const fs::path cfg = write("usage_codes.toml", hydrogel_config());
   for (const std::string& args : std::vector<std::string>{"track --config " + cfg.string() + " --input x --out y --frames abc",
                                                           "track --config " + cfg.string() + " --input x --out y --every 0",
-                                                          "plugins --log-level loud"}) {
+                                                          "plugins --log-level loud",
+                                                          "render --config " + cfg.string() +
+                                                              " --params 0,0,100,0,0,0,0,0,0,0,0,0 --out m.png "
+                                                              "--scale 0.001"}) {
     const CliRun r = gtrack(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.output;
   }

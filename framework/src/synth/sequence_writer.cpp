@@ -70,7 +70,9 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
     }
   };
   int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::clamp(threads, 1, std::max(1, n));
+  // More threads than cores only wait, each with a frame in memory.
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  threads = std::clamp(threads, 1, std::max(1, std::min(n, cores)));
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
