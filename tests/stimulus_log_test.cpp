@@ -9,6 +9,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/stimulus_log.hpp"
+#include "support/logged.hpp"
 
 namespace {
 
@@ -137,4 +138,27 @@ TEST(StimulusLog, FollowTakesAppendedWholeLines) {
   }
   std::ofstream(file) << "frame,value\n";
   EXPECT_THROW(log.poll(), gtrack::InputError);  // shrank: a new log, not this one
+}
+
+// A followed log that disappears is said once, and the readings so far are
+// kept; when it is back, its rows are taken again.
+TEST(StimulusLog, AFollowedLogThatIsGoneIsSaidOnce) {
+  namespace fs = std::filesystem;
+  const fs::path file = fs::temp_directory_path() / "gtrack_stimulus_gone.csv";
+  std::ofstream(file) << "frame,value\n0,22.5\n";
+  gtrack::StimulusLog log = gtrack::StimulusLog::follow(file);
+  ASSERT_TRUE(log.latest());
+  const std::string text = std::string("frame,value\n0,22.5\n");
+  fs::remove(file);
+  const std::string said = gtrack::testing::logged([&] {
+    EXPECT_FALSE(log.poll());
+    EXPECT_FALSE(log.poll());
+  });
+  EXPECT_NE(said.find("the followed stimulus log is gone"), std::string::npos) << said;
+  EXPECT_EQ(said.find("is gone"), said.rfind("is gone")) << "said once: " << said;
+  EXPECT_DOUBLE_EQ(*log.latest(), 22.5);
+  std::ofstream(file) << text << "1,24.0\n";
+  EXPECT_TRUE(log.poll());
+  EXPECT_DOUBLE_EQ(*log.latest(), 24.0);
+  fs::remove(file);
 }

@@ -65,6 +65,7 @@ class GTRACK_API StimulusLog {
   int lines_ = 0;                        // lines read so far (for error messages)
   std::filesystem::path followed_;       // follow(): the file
   std::streamoff read_to_ = 0;           // follow(): bytes taken (whole lines)
+  bool gone_ = false;                    // follow(): the file is missing, and that was said
 };
 
 }  // namespace gtrack

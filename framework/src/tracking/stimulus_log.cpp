@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/text_file.hpp"
 
 namespace gtrack {
@@ -128,7 +129,19 @@ StimulusLog StimulusLog::follow(const std::filesystem::path& file, ReadingCheck 
 bool StimulusLog::poll() {
   if (followed_.empty()) return false;
   std::ifstream in(followed_, std::ios::binary);
-  if (!in) return false;  // moved away for a moment: keep the readings so far
+  if (!in) {
+    // Moved away for a moment (a logger that replaces its file), or gone:
+    // the readings so far are kept, and the frames hold the last one.
+    if (!gone_) {
+      logger().warn("{}: the followed stimulus log is gone; frames hold its last reading until it is back", source_);
+      gone_ = true;
+    }
+    return false;
+  }
+  if (gone_) {
+    logger().info("{}: the followed stimulus log is back", source_);
+    gone_ = false;
+  }
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   if (size < read_to_) {
