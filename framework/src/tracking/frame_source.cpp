@@ -12,6 +12,7 @@
 #include <string_view>
 #include <thread>
 #include <unordered_set>
+#include <fmt/format.h>
 #include <chrono>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -533,14 +534,22 @@ class FolderSource final : public FrameSource {
       // file time is 2 s old (a finished file that always draws one); its
       // failure is judged here only, since a file server's clock may run
       // behind this one.
-      const bool settled = std::chrono::duration<double>(now - changed).count() > 2.0;
+      const double unchanged_s = std::chrono::duration<double>(now - changed).count();
+      const bool settled = unchanged_s > 2.0;
       const auto written = fs::last_write_time(p, ec);
       const bool old = !growing && !ec && fs::file_time_type::clock::now() - written > std::chrono::seconds(2);
       if (!img.empty() && (said.empty() || settled || old)) {
         if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
         return img;
       }
-      if (settled) fail_to_read(p, said);
+      // One that does not decode at all is waited on as long as a new image
+      // would be (--follow-input's seconds, 2 s at least): a writer may pause
+      // mid-file.
+      if (img.empty() && unchanged_s > std::max(2.0, follow_.idle_s)) {
+        fail_to_read(p, said + (said.empty() ? "" : "; ") + "unchanged for " +
+                            fmt::format("{:g}", std::max(2.0, follow_.idle_s)) +
+                            " s (--follow-input) and still not a whole image");
+      }
       if (follow_.cancel && follow_.cancel->load()) return {};
       pause();
     }
