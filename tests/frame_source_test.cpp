@@ -168,6 +168,36 @@ TEST(RecordedFrames, AFoldersBlocksAreItsImagesAndAMissingOneIsNamed) {
   }
 }
 
+// A stack cut short (a copy that stopped, a disk that filled): its pages end
+// where its directories do, and that is said, in the summary too, as for a
+// video; libtiff's own count had stopped there without a word.
+TEST(FrameSource, ATiffStackCutShortSaysWhereItsPagesEnd) {
+  const fs::path dir = folder_of("tiff_cut", {});
+  std::vector<cv::Mat> pages;
+  for (int i = 0; i < 6; ++i) pages.push_back(numbered_frame(i));
+  const fs::path whole = dir / "whole.tif", cut = dir / "cut.tif";
+  ASSERT_TRUE(cv::imwritemulti(whole.string(), pages));
+  {
+    std::ifstream in(whole, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() * 6 / 10);
+  }
+  const auto warned = gtrack::testing::logged([&] {
+    auto src = gtrack::open_frame_source(whole.string(), {128, 96}, {}, 25);
+    EXPECT_EQ(src->ended_early(), "");
+  });
+  EXPECT_EQ(warned.find("its pages end"), std::string::npos) << warned;
+  std::unique_ptr<gtrack::FrameSource> src;
+  const auto said = gtrack::testing::logged([&] { src = gtrack::open_frame_source(cut.string(), {128, 96}, {}, 25); });
+  ASSERT_GT(src->frame_count(), 0);
+  ASSERT_LT(src->frame_count(), 6);
+  EXPECT_NE(src->ended_early().find("its pages end after page " + std::to_string(src->frame_count() - 1) +
+                                    " with an error"),
+            std::string::npos)
+      << src->ended_early();
+  EXPECT_NE(said.find("cut.tif: its pages end after page"), std::string::npos) << said;
+}
+
 // A TIFF stack (ImageJ/Fiji, Micro-Manager): each page is a frame, 16-bit
 // and grey pages included; a range skips the pages before it, and the
 // backward pass reads its blocks by page.

@@ -5,9 +5,11 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdarg>
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
@@ -602,6 +604,32 @@ struct StackLayout {
   bool slices_are_times = false;  // no time points: the z-slices are taken as the frames
 };
 
+// What libtiff says is an error (not a warning about a private tag) while
+// every directory of a stack is read: a directory past the file's end (a
+// stack cut short) or a page it cannot take (ImageWidth 0) ends the pages
+// there, which imcount does without a word. "" when the chain is whole.
+std::string stack_directory_error(const std::string& file) {
+  static std::mutex one_at_a_time;  // libtiff's error handler is the process's
+  std::lock_guard lock(one_at_a_time);
+  static std::string said;
+  said.clear();
+  const TIFFErrorHandler before = TIFFSetErrorHandler([](const char* module, const char* fmt, va_list args) {
+    char text[512];
+    std::vsnprintf(text, sizeof text, fmt, args);
+    if (said.empty()) said = (module ? std::string(module) + ": " : std::string()) + text;
+  });
+  {
+    detail::CapturedStderr library;  // the warnings, about private tags
+    if (TIFF* tif = TIFFOpen(file.c_str(), "r")) {
+      while (TIFFReadDirectory(tif)) {
+      }
+      TIFFClose(tif);
+    }
+  }
+  TIFFSetErrorHandler(before);
+  return said;
+}
+
 std::optional<StackLayout> stack_layout(const std::string& file) {
   std::string description;
   std::uint16_t samples = 1;
@@ -694,7 +722,14 @@ class StackSource final : public FrameSource {
     }
     if (!said.empty()) logger().debug("{}: the decoder said: {}", spec_, said);
     layout_ = stack_layout(spec_);
+    if (const std::string broken = stack_directory_error(spec_); !broken.empty()) {
+      ended_early_ = "its pages end after page " + std::to_string(count_ - 1) + " with an error (the decoder said: " +
+                     library_words(broken) + ")";
+      logger().warn("{}: {}; the {} page{} before it {} tracked", spec_, ended_early_, count_, count_ == 1 ? "" : "s",
+                    count_ == 1 ? "is" : "are");
+    }
   }
+  std::string ended_early() const override { return ended_early_; }
 
   std::optional<Frame> next() override {
     if (layout_ && !quiet()) check_layout(*layout_);
@@ -789,6 +824,7 @@ class StackSource final : public FrameSource {
   std::vector<cv::Mat> block_;
   int block_first_ = 0;
   std::optional<StackLayout> layout_;  // checked at the first frame
+  std::string ended_early_;             // the directories end in an error
 };
 
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
