@@ -198,8 +198,8 @@ void warn_if_the_run_imaged_otherwise(const fs::path& estimates_file, const fs::
                           "otherwise): the errors are measured along {}'s axes, and the in-view shares from it",
                           run_config.string(), config.string(), config.string());
   }
-  // The same shape: the same link endpoints at a pose with every joint half
-  // folded.
+  // The same shape: the same link endpoints at a pose with every joint
+  // folded by 30 degrees.
   const gtrack::ArticulatedModel &a = run->model(), &b = setup.model();
   bool same = a.dims() == b.dims();
   if (same) {

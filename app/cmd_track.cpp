@@ -96,7 +96,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     opt.on_frame = [](const gtrack::Estimate& e) {
       if (g_reader_gone || g_stream_stalled) return;
       if (std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
-        (g_grace_over ? g_stream_stalled : g_reader_gone) = true;
+        (g_grace_over && errno != EPIPE ? g_stream_stalled : g_reader_gone) = true;
         g_stop = true;
       }
     };
@@ -114,6 +114,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
       throw gtrack::cli::UsageError("--two-pass cannot be combined with --follow-input or --follow-stimulus");
     }
     if (opt.restart_from) throw gtrack::cli::UsageError("--two-pass cannot be combined with --restart-from");
+    opt.feed_untracked_readings = false;  // the backward pass replays the tracked frames' readings only
     opt.on_frame = [&forward, streamed = opt.on_frame](const gtrack::Estimate& e) {
       if (streamed) streamed(e);
       forward.push_back(e);

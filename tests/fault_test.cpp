@@ -1321,11 +1321,15 @@ TEST(Fault, NonFiniteParameterVectorIsOneLine) {
 TEST(TextFile, LibraryWordsKeepWhatTheLibrarySaid) {
   EXPECT_EQ(gtrack::library_words("OpenCV(4.6.0) ./modules/core/src/alloc.cpp:73: error: (-4:Insufficient memory) "
                                   "Failed to allocate 4294967296 bytes in function 'OutOfMemoryError'\n"),
-            "Failed to allocate 4294967296 bytes");
+            "Insufficient memory: Failed to allocate 4294967296 bytes");
   EXPECT_EQ(gtrack::library_words("imreadmulti_('a.tif'): can't read data: OpenCV(4.6.0) "
                                   "./modules/imgcodecs/src/grfmt_tiff.cpp:704: error: (-2:Unspecified error) OpenCV "
                                   "TIFF: failed TIFFReadRGBAStrip(...) in function 'readData'"),
-            "imreadmulti_('a.tif'): can't read data: OpenCV TIFF: failed TIFFReadRGBAStrip(...)");
+            "imreadmulti_('a.tif'): can't read data: Unspecified error: OpenCV TIFF: failed TIFFReadRGBAStrip(...)");
+  EXPECT_EQ(gtrack::library_words("OpenCV(4.6.0) matrix.cpp:250: error: (-215:Assertion failed) s >= 0 in function 'f'"),
+            "Assertion failed: s >= 0");
+  EXPECT_EQ(gtrack::library_words("[mov,mp4,m4a,3gp,3g2,mj2 @ 0x55d0c0a1b2c0] moov atom not found"),
+            "mov,mp4,m4a,3gp,3g2,mj2: moov atom not found");
   EXPECT_EQ(gtrack::library_words("[mjpeg @ 0x563318912a40] overread 8; [h264 @ 0x55d0] error while decoding"),
             "mjpeg: overread 8; h264: error while decoding");
   EXPECT_EQ(gtrack::library_words("libpng error: Read Error"), "libpng error: Read Error");

@@ -23,10 +23,10 @@ std::string shown(std::string_view text, std::size_t max, bool ascii) {
 }
 
 std::string library_words(std::string text) {
-  static const std::regex opencv(R"(OpenCV\([0-9.]+[^)]*\) \S+:[0-9]+: error: \(-?[0-9]+:[^)]*\) )");
+  static const std::regex opencv(R"(OpenCV\([0-9.]+[^)]*\) \S+:[0-9]+: error: \(-?[0-9]+:([^)]*)\) )");
   static const std::regex function(R"( in function '[^']*')");
-  static const std::regex ffmpeg(R"(\[([A-Za-z0-9_ ]+) @ 0x[0-9a-fA-F]+\] )");
-  text = std::regex_replace(text, opencv, "");
+  static const std::regex ffmpeg(R"(\[([^\]@]+?) @ 0x[0-9a-fA-F]+\] )");
+  text = std::regex_replace(text, opencv, "$1: ");
   text = std::regex_replace(text, function, "");
   text = std::regex_replace(text, ffmpeg, "$1: ");
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.pop_back();

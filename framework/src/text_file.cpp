@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <system_error>
 
 #include "gtrack/error.hpp"
 
@@ -58,6 +59,9 @@ void write_text_file(const std::filesystem::path& file, const std::string& text)
   if (!out) throw InputError(file.string() + ": write failed (" + write_failure_reason() + ")");
 }
 
-std::string write_failure_reason() { return errno != 0 ? std::strerror(errno) : "disk full?"; }
+std::string write_failure_reason() {
+  // std::error_code's message, not strerror: synth's threads write frames.
+  return errno != 0 ? std::error_code(errno, std::generic_category()).message() : "disk full?";
+}
 
 }  // namespace gtrack

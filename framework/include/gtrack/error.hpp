@@ -46,7 +46,8 @@ GTRACK_API std::string shown(std::string_view text, std::size_t max = std::strin
 
 // A library's own words, as a message quotes them: OpenCV's "OpenCV(4.6.0)
 // ./modules/core/src/alloc.cpp:73: error: (-4:Insufficient memory) Failed
-// to allocate ... in function 'f'" becomes "Failed to allocate ...", and
+// to allocate ... in function 'f'" becomes "Insufficient memory: Failed to
+// allocate ...", and
 // FFmpeg's "[h264 @ 0x55d0c0a1b2c0] error while decoding" becomes "h264:
 // error while decoding"; trailing line ends go.
 GTRACK_API std::string library_words(std::string text);

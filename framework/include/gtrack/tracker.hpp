@@ -186,6 +186,11 @@ struct TrackOptions {
   // loses nothing either; a power loss can lose what the system had not yet
   // written, and --resume then refuses with a one-line error.
   bool durable = false;
+  // The stimulus plugin is also fed the log's readings of the frames not
+  // tracked (before --frames A:B's first, between --every's). Off for a
+  // two-pass run, whose backward pass replays the tracked frames' readings
+  // only, so that both passes see the stimulus in the same states.
+  bool feed_untracked_readings = true;
   // The stimulus log is still being written (a live run): before each frame
   // its new rows are read, and the frame takes the last row's reading.
   bool follow_stimulus = false;

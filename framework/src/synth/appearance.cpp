@@ -119,13 +119,18 @@ cv::Mat lens_map(const Sensor& sensor) {
     for (int gx = 0; gx < gw; ++gx) {
       const Eigen::Vector2d d(gx * kStep + 0.5, gy * kStep + 0.5);
       Eigen::Vector2d u = d;
-      for (int it = 0; it < 50; ++it) {
+      bool converged = false;
+      for (int it = 0; it < 50 && !converged; ++it) {
         const auto f = drawn_at(u);
         if (!f) break;
         const Eigen::Vector2d step = d - *f;
         u += step;
-        if (step.norm() < 1e-4) break;
+        converged = step.norm() < 1e-3;
       }
+      // Where the lens model folds back (a strong barrel's corners), no
+      // point of the linear image is drawn there: far outside, so that the
+      // frame's border repeats.
+      if (!converged) u = Eigen::Vector2d(-1e6, -1e6);
       grid.at<cv::Vec2d>(gy, gx) = cv::Vec2d(u.x() - 0.5, u.y() - 0.5);  // OpenCV's pixel centres
     }
   }

@@ -31,7 +31,11 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   // stopped part way (Ctrl-C), would score them: both go first. The truth
   // is written once every frame is.
   int stale = remove_frame_images(out / "frames");
-  for (const char* name : {"ground_truth.csv", "stimulus.csv", "sequence.toml"}) stale += fs::remove(out / name, ec);
+  for (const char* name : {"ground_truth.csv", "stimulus.csv", "sequence.toml"}) {
+    // The config this run reads (an earlier sequence.toml given as --config) stays until replaced.
+    if (!setup.root.source().empty() && fs::equivalent(out / name, setup.root.source(), ec)) continue;
+    stale += fs::remove(out / name, ec);
+  }
   for (const auto& entry : fs::directory_iterator(out / "frames", ec)) {
     if (entry.path().extension() == ".part") fs::remove(entry.path(), ec);  // a frame a stopped run was writing
   }
@@ -58,8 +62,15 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
           throw InputError(file.string() + ": cannot encode");
         }
         const fs::path part = out / "frames" / ("." + std::string(name) + ".part");
-        write_text_file(part, std::string(png.begin(), png.end()));
         std::error_code renamed;
+        try {
+          write_text_file(part, std::string(png.begin(), png.end()));
+        } catch (const InputError& e) {
+          fs::remove(part, renamed);
+          std::string what = e.what();  // said of the frame, not of its stand-in
+          if (what.rfind(part.string(), 0) == 0) what.replace(0, part.string().size(), file.string());
+          throw InputError(what);
+        }
         fs::rename(part, file, renamed);
         if (renamed) throw InputError(file.string() + ": cannot write (" + renamed.message() + ")");
       } catch (const std::exception& e) {

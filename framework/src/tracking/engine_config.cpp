@@ -2,6 +2,7 @@
 #include "gtrack/engine_config.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
@@ -106,7 +107,9 @@ RenderOptions read_render(const ConfigTable& t, const Sensor& sensor) {
   r.egl_device = t.string_or("egl_device", r.egl_device);
   // Whether the device exists is the gl backend's to say; the form is known here.
   const std::string& d = r.egl_device;
-  if (!(d.empty() || d == "surfaceless" ||
+  std::string lower = d;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!(d.empty() || lower == "surfaceless" ||
         (d.size() <= 6 && std::all_of(d.begin(), d.end(), [](char c) { return c >= '0' && c <= '9'; })))) {
     t.fail("egl_device", "'" + shown(d, 60) + "'; expected a device index (0, 1, ...), \"surfaceless\" or \"\" (any)");
   }

@@ -506,10 +506,11 @@ class FolderSource final : public FrameSource {
   }
 
   // An image that does not decode is an error. Following, it may still be
-  // being written: while its size keeps changing, or for two seconds after
-  // it last changed, it is read again (also when it decodes but the decoder
-  // complains, as it does about a half-written JPEG: it is taken once it
-  // has been unchanged for those two seconds, by its size or its file time,
+  // being written: while its size keeps changing, and for --follow-input's
+  // seconds (2 at least) after it last changed, it is read again (also
+  // when it decodes but the decoder complains, as it does about a
+  // half-written JPEG: it is taken once it has been unchanged for two
+  // seconds, by its size or its file time,
   // with a warning naming it). A cancel while waiting returns an empty image.
   cv::Mat read(const fs::path& p) const {
     auto changed = std::chrono::steady_clock::now();
@@ -725,8 +726,7 @@ class StackSource final : public FrameSource {
     if (const std::string broken = stack_directory_error(spec_); !broken.empty()) {
       ended_early_ = "its pages end after page " + std::to_string(count_ - 1) + " with an error (the decoder said: " +
                      library_words(broken) + ")";
-      logger().warn("{}: {}; the {} page{} before it {} tracked", spec_, ended_early_, count_, count_ == 1 ? "" : "s",
-                    count_ == 1 ? "is" : "are");
+      logger().warn("{}: {}; the pages before it are tracked", spec_, ended_early_);
     }
   }
   std::string ended_early() const override { return ended_early_; }

@@ -263,7 +263,12 @@ class OutputLock {
     const fs::path file = dir / ".gtrack_lock";
     fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd_ < 0) throw InputError(file.string() + ": cannot open (" + std::strerror(errno) + ")");
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int locked = ::flock(fd_, LOCK_EX | LOCK_NB) == 0 ? 0 : errno;
+    if (locked != 0 && locked != EWOULDBLOCK) {
+      // A file system without locks (some network mounts): nothing to say
+      // who else writes there, so the run goes on without one.
+      logger().debug("{}: cannot be locked ({})", file.string(), std::strerror(locked));
+    } else if (locked == EWOULDBLOCK) {
       char pid[32] = {};
       const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
       ::close(fd_);
@@ -365,8 +370,14 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
             1 << 16);
   if (options.resume && fs::exists(state_file)) {
     resumed = read_tracker_state(state_file);
-    if (!resumed->run.empty() && resumed->run != run) {
-      throw InputError(state_file.string() + ": the interrupted run tracked " + shown(resumed->run, 300) +
+    // A state written before the run line named its first frame started
+    // at frame 0.
+    std::string ran = resumed->run;
+    if (!ran.empty() && ran.find(" from=") == std::string::npos && ran.find(" every=") != std::string::npos) {
+      ran.insert(ran.find(" every="), " from=0");
+    }
+    if (!ran.empty() && ran != run) {
+      throw InputError(state_file.string() + ": the interrupted run tracked " + shown(ran, 300) +
                        "; this one " + shown(run, 300) +
                        "; cannot resume (give the same --input, first frame of --frames, --every and --stimulus, or another "
                        "--out; a run that followed its stimulus log cannot be resumed)");
@@ -456,6 +467,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       logger().warn("{}: no frame to track; {} is left as it was", options.input, options.out_dir.string());
       TrackSummary none;
       none.cancelled = options.cancel && options.cancel->load();
+      none.mean_cost = std::numeric_limits<double>::quiet_NaN();
       return none;
     }
   }
@@ -504,7 +516,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // only its last).
   int fed = 0;  // the frames before this one have been fed
   const auto feed_untracked = [&](int index) {
-    if (log && !options.follow_stimulus) {
+    if (log && !options.follow_stimulus && options.feed_untracked_readings) {
       for (; fed < index; ++fed) {
         if (const auto r = log->value_at(fed, fed / fps)) tracker.replay_stimulus(r, fed / fps);
       }
