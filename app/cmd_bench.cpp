@@ -14,6 +14,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/renderer.hpp"
+#include "gtrack/results.hpp"
 
 namespace po = boost::program_options;
 
@@ -26,23 +27,6 @@ struct Measured {
   std::optional<double> value;
   std::string note;  // why there is no value
 };
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 std::string json_number(const std::optional<double>& v) {
   if (!v) return "null";
@@ -140,9 +124,9 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
               << " \"cpu_over_opencv_baseline\": {\"1\": " << json_number(ratio_one) << ", \"" << all
               << "\": " << json_number(ratio_all) << "},\n"
               << " \"threads\": " << all << ", \"batch\": " << batch << ", \"render_size\": [" << kSide << ", " << kSide
-              << "], \"gripper_px\": " << kGripperPx << ", \"gripper\": " << json_string(gripper_source)
+              << "], \"gripper_px\": " << kGripperPx << ", \"gripper\": " << gtrack::json_string(gripper_source)
               << ", \"seconds_per_measurement\": " << seconds;
-    if (!gl.value) std::cout << ",\n \"gl_unavailable\": " << json_string(gl.note);
+    if (!gl.value) std::cout << ",\n \"gl_unavailable\": " << gtrack::json_string(gl.note);
     std::cout << "}\n";
     return 0;
   }

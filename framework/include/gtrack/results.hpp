@@ -33,6 +33,11 @@ class GTRACK_API ResultWriter {
   std::filesystem::path dir_;
 };
 
+// A JSON string literal of free text (a decoder's message, a file name):
+// quotes and backslashes escaped, control bytes and bytes that are not
+// UTF-8 (a Latin-1 file name) as \u00XX.
+GTRACK_API std::string json_string(const std::string& text);
+
 // One line of estimates.jsonl (without its newline).
 GTRACK_API std::string estimate_json(const Estimate& estimate);
 

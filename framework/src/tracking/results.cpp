@@ -43,30 +43,6 @@ size_t utf8_length(const std::string& text, size_t i) {
   return n;
 }
 
-// A JSON string literal of free text (a decoder's message, a file name).
-// JSON is UTF-8: a byte that is not (a file name in Latin-1) is written as
-// the code point of the same number, \u00XX.
-std::string json_string(const std::string& text) {
-  std::string s = "\"";
-  for (size_t i = 0; i < text.size();) {
-    const char c = text[i];
-    const size_t n = utf8_length(text, i);
-    if (c == '"' || c == '\\') {
-      s += '\\';
-      s += c;
-    } else if (n == 0 || static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      s += buf;
-    } else {
-      s.append(text, i, n);
-      i += n;
-      continue;
-    }
-    ++i;
-  }
-  return s + "\"";
-}
 
 std::ofstream open_for_writing(const fs::path& p, bool append) {
   errno = 0;
@@ -107,6 +83,31 @@ void rewrite(const fs::path& p, const std::vector<std::string>& lines) {
 }
 
 }  // namespace
+
+// A JSON string literal of free text (a decoder's message, a file name).
+// JSON is UTF-8: a byte that is not (a file name in Latin-1) is written as
+// the code point of the same number, \u00XX.
+std::string json_string(const std::string& text) {
+  std::string s = "\"";
+  for (size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    const size_t n = utf8_length(text, i);
+    if (c == '"' || c == '\\') {
+      s += '\\';
+      s += c;
+    } else if (n == 0 || static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      s += buf;
+    } else {
+      s.append(text, i, n);
+      i += n;
+      continue;
+    }
+    ++i;
+  }
+  return s + "\"";
+}
 
 ResultWriter::ResultWriter(const fs::path& out_dir, int fingers, bool append) : dir_(out_dir) {
   std::error_code ec;
