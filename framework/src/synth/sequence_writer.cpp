@@ -14,6 +14,7 @@
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/synth.hpp"
 #include "gtrack/text_file.hpp"
+#include "tracking/replace_file.hpp"
 
 namespace gtrack {
 
@@ -37,7 +38,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
     stale += fs::remove(out / name, ec);
   }
   for (const auto& entry : fs::directory_iterator(out / "frames", ec)) {
-    if (entry.path().extension() == ".part") fs::remove(entry.path(), ec);  // a frame a stopped run was writing
+    if (entry.path().extension() == ".tmp") fs::remove(entry.path(), ec);  // a frame a stopped run was writing
   }
   if (stale > 0) logger().info("{}: removed the files of an earlier sequence", out.string());
 
@@ -61,18 +62,7 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
         if (!cv::imencode(".png", img, png, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
           throw InputError(file.string() + ": cannot encode");
         }
-        const fs::path part = out / "frames" / ("." + std::string(name) + ".part");
-        std::error_code renamed;
-        try {
-          write_text_file(part, std::string(png.begin(), png.end()));
-        } catch (const InputError& e) {
-          fs::remove(part, renamed);
-          std::string what = e.what();  // said of the frame, not of its stand-in
-          if (what.rfind(part.string(), 0) == 0) what.replace(0, part.string().size(), file.string());
-          throw InputError(what);
-        }
-        fs::rename(part, file, renamed);
-        if (renamed) throw InputError(file.string() + ": cannot write (" + renamed.message() + ")");
+        detail::replace_file(file, std::string(png.begin(), png.end()));
       } catch (const std::exception& e) {
         std::lock_guard lock(failure_mutex);
         failure = e.what();
