@@ -1013,4 +1013,27 @@ TEST(Cli, SynthKeepsTheConfigsFilesAndReadsAPipeOnce) {
   EXPECT_TRUE(fs::exists(piped / "sequence.toml"));
 }
 
+// Frames are decoded on a thread of their own while the tracker works, and
+// a decoder's complaints are taken aside from fd 2 meanwhile: gtrack's own
+// lines (here a progress line a frame) are written past that, and every one
+// of them reaches stderr.
+TEST(Cli, EveryProgressLineReachesStderrWhileFramesAreDecoded) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "progress";
+  fs::remove_all(dir);
+  constexpr int kFrames = 16;
+  ASSERT_EQ(gtrack("synth --frames " + std::to_string(kFrames) + " --seed 4 --out " + dir.string()).code, 0);
+  const std::string config = read_file(dir / "sequence.toml");
+  ASSERT_NE(config.find("[tracker]\n"), std::string::npos);
+  std::ofstream(dir / "progress.toml") << replaced(config, "[tracker]\n", "[tracker]\nprogress_every = 1\n");
+  const CliRun r = gtrack("track -c " + (dir / "progress.toml").string() + " -i " + (dir / "frames").string() +
+                          " -o " + (dir / "out").string() + " --no-overlay");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (int k = 0; k < kFrames; ++k) {
+    const std::string line = "frame " + std::to_string(k) + " (" + std::to_string(k + 1) + "/" +
+                             std::to_string(kFrames) + ")";
+    EXPECT_NE(r.output.find(line), std::string::npos) << line << " missing from:\n" << r.output;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace

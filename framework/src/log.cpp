@@ -1,16 +1,41 @@
 // The one logger of the process, shared with every plugin.
 #include "gtrack/log.hpp"
 
-#include <opencv2/core/utils/logger.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
+#include <fcntl.h>
+#include <unistd.h>
 
+#include <opencv2/core/utils/logger.hpp>
+#include <spdlog/sinks/ansicolor_sink.h>
+
+#include "console.hpp"
 #include "gtrack/error.hpp"
 
 namespace gtrack {
 
+namespace detail {
+
+std::FILE* console() {
+  static std::FILE* const stream = [] {
+    const int fd = ::fcntl(STDERR_FILENO, F_DUPFD_CLOEXEC, 3);
+    std::FILE* f = fd >= 0 ? ::fdopen(fd, "w") : nullptr;
+    if (!f) {
+      if (fd >= 0) ::close(fd);
+      return stderr;
+    }
+    std::setvbuf(f, nullptr, _IONBF, 0);  // as stderr: each message out as it is written
+    return f;
+  }();
+  return stream;
+}
+
+}  // namespace detail
+
 spdlog::logger& logger() {
   static std::shared_ptr<spdlog::logger> log = [] {
-    auto l = spdlog::stderr_color_mt("gtrack");
+    auto sink = std::make_shared<spdlog::sinks::ansicolor_sink<spdlog::details::console_mutex>>(
+        detail::console(), spdlog::color_mode::automatic);
+    auto l = std::make_shared<spdlog::logger>("gtrack", std::move(sink));
+    spdlog::register_logger(l);
     l->set_pattern("[%l] %v");
     return l;
   }();

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <string>
 
+#include "console.hpp"
 #include "gtrack/error.hpp"
 
 namespace gtrack::detail {
@@ -18,6 +19,7 @@ class CapturedStderr {
  public:
   // One capture at a time in the process: fd 2 is the process's.
   CapturedStderr() : lock_(mutex()) {
+    console();  // gtrack's own messages keep the stderr of before
     std::fflush(stderr);
     file_ = std::tmpfile();
     saved_ = file_ ? ::dup(STDERR_FILENO) : -1;

@@ -23,7 +23,9 @@
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
 #include "captured_stderr.hpp"
+#include "console.hpp"
 #include "nearest_equivalent.hpp"
+#include "pipeline.hpp"
 #include "video_backend.hpp"
 #include "replace_file.hpp"
 #include "run_config.hpp"
@@ -39,18 +41,24 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // mp4 where the OpenCV build can write it, MJPG in AVI everywhere else.
+// Frames are encoded on a thread of their own, two at most waiting.
 class OverlayWriter {
  public:
   OverlayWriter(fs::path dir, double fps, std::string stem)
       : dir_(std::move(dir)), fps_(fps > 0 ? fps : 30), stem_(std::move(stem)) {}
-  void write(const cv::Mat& img) {
-    if (!writer_.isOpened() && !failed_) open(img.size());
-    if (writer_.isOpened()) writer_.write(img);
+  void write(cv::Mat img) { encoder_.give(std::move(img)); }
+  // Waits for the frames given to be encoded; file() is then the video's.
+  void close() {
+    encoder_.finish();
+    writer_.release();
   }
-  void close() { writer_.release(); }
   const fs::path& file() const { return file_; }
 
  private:
+  void encode(const cv::Mat& img) {
+    if (!writer_.isOpened() && !failed_) open(img.size());
+    if (writer_.isOpened()) writer_.write(img);
+  }
   void open(cv::Size size) {
     const fs::path mp4 = dir_ / (stem_ + ".mp4");
     for (const char* cc : {"avc1", "mp4v"}) {
@@ -75,6 +83,7 @@ class OverlayWriter {
   cv::VideoWriter writer_;
   fs::path file_;
   bool failed_ = false;
+  detail::Behind<cv::Mat> encoder_{2, [this](cv::Mat& img) { encode(img); }};  // last: its thread uses the rest
 };
 
 // The overlays of the runs before a resumed one: a video killed before it
@@ -104,7 +113,7 @@ void check_earlier_overlays(const fs::path& dir, const std::string& own) {
 class Progress {
  public:
   Progress(bool enabled, int total, int every) : enabled_(enabled), total_(total), every_(every) {
-    tty_ = ::isatty(STDERR_FILENO) != 0;
+    tty_ = ::isatty(::fileno(detail::console())) != 0;
   }
   void update(int done, int frame, double elapsed_s) {
     if (!enabled_) return;
@@ -126,12 +135,12 @@ class Progress {
     } else {
       std::snprintf(line, sizeof line, "frame %d (%d)  %.1f fps", frame, done, fps);
     }
-    std::fprintf(stderr, tty_ ? "\r%-70s" : "%s\n", line);
-    std::fflush(stderr);
+    std::fprintf(detail::console(), tty_ ? "\r%-70s" : "%s\n", line);
+    std::fflush(detail::console());
     printed_ = true;
   }
   void finish() {
-    if (enabled_ && tty_ && printed_) std::fprintf(stderr, "\n");
+    if (enabled_ && tty_ && printed_) std::fprintf(detail::console(), "\n");
   }
 
  private:
@@ -396,9 +405,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     logger().info("{}: no tracker state to resume from; starting from the first frame", state_file.string());
   }
+  // Raised to stop a followed folder's wait: at a cancel, or when the run
+  // stops reading.
+  std::atomic<bool> halt_reading{false};
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
                                   config.tracker.fps > 0 ? config.tracker.fps : 30.0,
-                                  FollowOptions{options.follow_input_s, options.cancel});
+                                  FollowOptions{options.follow_input_s, &halt_reading});
   source->set_image_bits(config.tracker.image_bits);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
   if (config.tracker.fps > 0 && source->fps() > 0 && std::abs(source->fps() / config.tracker.fps - 1) > 0.01) {
@@ -408,7 +420,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                   "stimulus log and the material's response run on {:g} (remove fps to take the video's)",
                   options.input, source->fps(), config.tracker.fps, config.tracker.fps);
   }
-  if (!resumed && expected_frames(*source, range) == 0) {
+  const int expected = expected_frames(*source, range);
+  const std::string described = source->description();
+  if (!resumed && expected == 0) {
     throw InputError(options.input + ": holds " + std::to_string(source->frame_count()) +
                      " frames, none of them in --frames " + std::to_string(range.first) + ":" +
                      (range.last >= 0 ? std::to_string(range.last) : std::string()));
@@ -451,13 +465,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // replaced: an input that fails at once (another image size, a video
   // that does not decode) leaves that run as it was, and so does a
   // followed folder that never gets an image.
+  detail::ReadAhead reader(*source, halt_reading, options.cancel);
   std::optional<Frame> pending;
   double pending_read_s = 0;
   if (!resumed) {
-    const auto t = Clock::now();
-    pending = source->next();
-    pending_read_s = seconds_since(t);
+    pending = reader.next(pending_read_s);
     if (!pending) {
+      reader.stop();
       // A damaged video that stops before the range's first frame.
       if (const std::string ended = source->ended_early(); !ended.empty()) {
         throw InputError(options.input + ": " + ended + ", before the first frame of --frames " +
@@ -538,7 +552,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", range.first);
   if (resumed && want_overlay) check_earlier_overlays(options.out_dir, overlay_stem);
   OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem);
-  Progress progress(options.progress, expected_frames(*source, range), config.tracker.progress_every);
+  Progress progress(options.progress, expected, config.tracker.progress_every);
 
   if (!log && !config.tracker.default_stimulus) {
     logger().info("no stimulus log and no [tracker] default_stimulus: S(H) and the biased initialisation are off");
@@ -546,7 +560,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     logger().info("no stimulus log: the stimulus is held at [tracker] default_stimulus = {}",
                   *config.tracker.default_stimulus);
   }
-  logger().info("tracking {} with the {} renderer ({}x{} render size), N={} G={}", source->description(),
+  logger().info("tracking {} with the {} renderer ({}x{} render size), N={} G={}", described,
                 tracker.renderer().name(), tracker.renderer().render_size().width,
                 tracker.renderer().render_size().height, config.pso.particles, config.pso.generations);
 
@@ -564,6 +578,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // error that stops the run.
   const auto finish = [&] {
     progress.finish();
+    reader.stop();
     results.close();
     overlay.close();
     const int n = std::max(1, summary.frames);
@@ -581,15 +596,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         summary.cancelled = true;
         break;
       }
-      const auto t_read = Clock::now();
       std::optional<Frame> frame;
       double read_s = pending_read_s;
       if (!pending_taken) {
         frame = std::move(pending);
         pending_taken = true;
       } else {
-        frame = source->next();
-        read_s = seconds_since(t_read);
+        frame = reader.next(read_s);
       }
       if (!frame) {
         // A followed folder's wait ends at a cancel as at its idle limit; any
@@ -597,7 +610,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         summary.cancelled = options.follow_input_s > 0 && options.cancel && options.cancel->load();
         break;
       }
-      double io_ms = (read_s - frame->waited_s) * 1e3;
+      // Reading as far as the tracker waited for it, less the camera's time.
+      double io_ms = std::max(0.0, read_s - frame->waited_s) * 1e3;
       const double time_s = frame->index / fps;
       feed_untracked(frame->index);
       const std::optional<double> reading = reading_at(frame->index, time_s);
