@@ -7,8 +7,16 @@
 
 namespace gtrack::detail {
 
+std::string reading_text(const Stimulus* stimulus, const Estimate& estimate) {
+  if (!stimulus || !estimate.stimulus) return {};
+  char text[96];
+  std::snprintf(text, sizeof text, "%s = %.1f %s", stimulus->reading_label().c_str(), *estimate.stimulus,
+                stimulus->reading_unit().c_str());
+  return text;
+}
+
 cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const ArticulatedModel& model,
-                      const Stimulus* stimulus, const Estimate& estimate) {
+                      const std::string& reading, const Estimate& estimate) {
   cv::Mat out = frame.clone();
   const bool lost = estimate.status == TrackStatus::Lost;
   // Green, orange for a lost frame's held estimate, fill and outline alike.
@@ -38,15 +46,12 @@ cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const Articula
   }
   const double font = std::max(0.5, frame.rows / 900.0);
   const int thick = std::max(1, static_cast<int>(font * 1.5));
-  if (stimulus && estimate.stimulus) {
-    char text[96];
-    std::snprintf(text, sizeof text, "%s = %.1f %s", stimulus->reading_label().c_str(), *estimate.stimulus,
-                  stimulus->reading_unit().c_str());
+  if (!reading.empty()) {
     int base = 0;
-    const cv::Size ts = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, font, thick, &base);
+    const cv::Size ts = cv::getTextSize(reading, cv::FONT_HERSHEY_SIMPLEX, font, thick, &base);
     const cv::Point at(frame.cols - ts.width - 12, frame.rows - 12);
-    cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(0, 0, 0), thick + 2, cv::LINE_AA);
-    cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(255, 255, 255), thick, cv::LINE_AA);
+    cv::putText(out, reading, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(0, 0, 0), thick + 2, cv::LINE_AA);
+    cv::putText(out, reading, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(255, 255, 255), thick, cv::LINE_AA);
   }
   if (lost) {
     cv::putText(out, "lost", cv::Point(12, static_cast<int>(30 * font)), cv::FONT_HERSHEY_SIMPLEX, font,

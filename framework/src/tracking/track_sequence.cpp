@@ -25,6 +25,7 @@
 #include "captured_stderr.hpp"
 #include "console.hpp"
 #include "nearest_equivalent.hpp"
+#include "overlay.hpp"
 #include "pipeline.hpp"
 #include "video_backend.hpp"
 #include "replace_file.hpp"
@@ -40,13 +41,17 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// mp4 where the OpenCV build can write it, MJPG in AVI everywhere else.
-// Frames are encoded on a thread of their own, two at most waiting.
+// The estimates drawn on their frames (detail::draw_estimate), into mp4
+// where the OpenCV build can write it, MJPG in AVI everywhere else. Frames
+// are drawn and encoded on a thread of their own, two at most waiting.
 class OverlayWriter {
  public:
-  OverlayWriter(fs::path dir, double fps, std::string stem)
-      : dir_(std::move(dir)), fps_(fps > 0 ? fps : 30), stem_(std::move(stem)) {}
-  void write(cv::Mat img) { encoder_.give(std::move(img)); }
+  OverlayWriter(fs::path dir, double fps, std::string stem, const Sensor& sensor, const ArticulatedModel& model)
+      : dir_(std::move(dir)), fps_(fps > 0 ? fps : 30), stem_(std::move(stem)), sensor_(sensor), model_(model) {}
+  // `reading`: detail::reading_text, taken where the stimulus plugin is used.
+  void write(cv::Mat frame, Estimate estimate, std::string reading) {
+    encoder_.give(Job{std::move(frame), std::move(estimate), std::move(reading)});
+  }
   // Waits for the frames given to be encoded; file() is then the video's.
   void close() {
     encoder_.finish();
@@ -55,9 +60,14 @@ class OverlayWriter {
   const fs::path& file() const { return file_; }
 
  private:
-  void encode(const cv::Mat& img) {
-    if (!writer_.isOpened() && !failed_) open(img.size());
-    if (writer_.isOpened()) writer_.write(img);
+  struct Job {
+    cv::Mat frame;
+    Estimate estimate;
+    std::string reading;
+  };
+  void encode(const Job& job) {
+    if (!writer_.isOpened() && !failed_) open(job.frame.size());
+    if (writer_.isOpened()) writer_.write(detail::draw_estimate(job.frame, sensor_, model_, job.reading, job.estimate));
   }
   void open(cv::Size size) {
     const fs::path mp4 = dir_ / (stem_ + ".mp4");
@@ -81,9 +91,11 @@ class OverlayWriter {
   double fps_;
   std::string stem_;
   cv::VideoWriter writer_;
+  const Sensor& sensor_;
+  const ArticulatedModel& model_;
   fs::path file_;
   bool failed_ = false;
-  detail::Behind<cv::Mat> encoder_{2, [this](cv::Mat& img) { encode(img); }};  // last: its thread uses the rest
+  detail::Behind<Job> encoder_{2, [this](Job& job) { encode(job); }};  // last: its thread uses the rest
 };
 
 // The overlays of the runs before a resumed one: a video killed before it
@@ -551,7 +563,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   char overlay_stem[48] = "overlay";
   if (resumed) std::snprintf(overlay_stem, sizeof overlay_stem, "overlay_from_%06d", range.first);
   if (resumed && want_overlay) check_earlier_overlays(options.out_dir, overlay_stem);
-  OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem);
+  OverlayWriter overlay(options.out_dir, fps / std::max(1, options.range.every), overlay_stem, *setup.sensor,
+                        setup.model());
   Progress progress(options.progress, expected, config.tracker.progress_every);
 
   if (!log && !config.tracker.default_stimulus) {
@@ -650,7 +663,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         const fs::path p = options.out_dir / "masks" / name;
         if (!cv::imwrite(p.string(), tracker.last_observation().mask)) throw InputError(p.string() + ": cannot write");
       }
-      if (want_overlay) overlay.write(tracker.draw_overlay(frame->image, e));
+      if (want_overlay) overlay.write(frame->image, e, detail::reading_text(setup.stimulus.get(), e));
       TrackerState state = tracker.state();
       state.run = run;
       write_tracker_state(state_file, state, options.durable);

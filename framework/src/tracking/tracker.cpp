@@ -749,8 +749,8 @@ const ParameterSpace& Tracker::space() const { return impl_->config.space; }
 namespace gtrack {
 
 cv::Mat Tracker::draw_overlay(const cv::Mat& frame, const Estimate& estimate) const {
-  return detail::draw_estimate(frame, *impl_->world_sensor, impl_->setup.model(), impl_->setup.stimulus.get(),
-                               estimate);
+  return detail::draw_estimate(frame, *impl_->world_sensor, impl_->setup.model(),
+                               detail::reading_text(impl_->setup.stimulus.get(), estimate), estimate);
 }
 
 }  // namespace gtrack
