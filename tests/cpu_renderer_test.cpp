@@ -11,6 +11,7 @@
 #include <new>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -388,6 +389,30 @@ TEST(CpuRenderer, AGripperLargerThanTheImageCoversEveryPixel) {
   EXPECT_EQ(count(r->render_mask(h)), 256 * 256);
   h[2] = -5;  // behind the camera
   EXPECT_EQ(count(r->render_mask(h)), 0);
+}
+
+// A configuration sent absurdly far (gtrack render -p, a plugin's start)
+// shows nothing: its vertices overflow u * w to inf, which must not make
+// them inside the frustum, nor reach the rasteriser's integer snapping (run
+// under the sanitizers in CI).
+TEST(CpuRenderer, AConfigurationAbsurdlyFarShowsNothing) {
+  gtrack::RadialGripperSpec s;
+  s.name = "six";
+  s.palm_circumradius_mm = 1;
+  s.links = {{0.5, 0.4, 0.2}};
+  const ArticulatedModel m(gtrack::make_radial_gripper(s));
+  auto r = cpu(m, camera(), kScale, 1);
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(12);
+  h[2] = 34;
+  EXPECT_GT(count(r->render_mask(h)), 0);
+  for (const double far : {1e300, 1e308, std::numeric_limits<double>::max()}) {
+    h[2] = far;
+    EXPECT_EQ(count(r->render_mask(h)), 0) << far;
+    h[2] = 34;
+    h[0] = far;
+    EXPECT_EQ(count(r->render_mask(h)), 0) << far;
+    h[0] = 0;
+  }
 }
 
 TEST(CpuRenderer, ThreadsGiveTheSameCountsAsOneThread) {

@@ -20,12 +20,16 @@ inline constexpr int kMaxSensorPlanes = 8;
 // The region every polygon is clipped to besides the sensor's planes, in
 // homogeneous image coordinates (u*w, v*w, w): w above a tiny positive
 // limit, and u, v within a guard band of one image size around the image.
+// Beyond kFarW, u_hi * w may overflow: such a vertex (a configuration sent
+// absurdly far, inf, nan) is never inside, and clip_triangle drops it.
+inline constexpr double kFarW = 1e200;
 struct Frustum {
   double u_lo, u_hi, v_lo, v_hi, w_min;
   bool contains(const Eigen::Vector3d& h) const {
     const double w = h.z();
     // Non-short-circuit: almost every vertex is inside, and branches cost more than the compares.
-    return (w >= w_min) & (h.x() >= u_lo * w) & (h.x() <= u_hi * w) & (h.y() >= v_lo * w) & (h.y() <= v_hi * w);
+    return (w >= w_min) & (w <= kFarW) & (h.x() >= u_lo * w) & (h.x() <= u_hi * w) & (h.y() >= v_lo * w) &
+           (h.y() <= v_hi * w);
   }
 };
 

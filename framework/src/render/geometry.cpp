@@ -100,6 +100,8 @@ void clip_triangle(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const E
   bool all_in = true;
   for (int i = 0; i < n; ++i) {
     a[i] = project(projection, a[i]);
+    // Clipping it would overflow to inf - inf (and nan is nowhere).
+    if (!(a[i].cwiseAbs().maxCoeff() <= kFarW)) return;
     all_in = all_in && f.contains(a[i]);
   }
   if (!all_in) {
