@@ -140,6 +140,14 @@ TEST(HydrogelModel, ConfigOverridesAreValidated) {
   }
   auto g = make_gripper("plugin = \"hydrogel_six_finger\"\nlink_lengths_mm = [0.5, 0.5]\nlink_widths_mm = [0.5, 0.4, 0]");
   EXPECT_EQ(g->model().triangles(), 4 + 6 * 3);
+  // Limits that leave out the built-in open and folded joints (0 and 60):
+  // those are brought within them, as the tracker and synth start there.
+  for (const char* metal : {"hydrogel_six_finger", "metallic_six_finger", "metallic_two_finger"}) {
+    SCOPED_TRACE(metal);
+    const auto limited = make_gripper(std::string("plugin = \"") + metal + "\"\njoint_min_deg = 20\njoint_max_deg = 50");
+    EXPECT_EQ(limited->model().geometry().unfolded_deg, 20);
+    EXPECT_EQ(limited->model().geometry().folded_deg, 50);
+  }
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // Radial gripper geometry from a [gripper] table with built-in defaults.
 #include "gtrack/gripper_config.hpp"
 
+#include <algorithm>
+
 #include "gtrack/error.hpp"
 
 namespace gtrack {
@@ -39,9 +41,12 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
   g.collision.max_difference_deg =
       t.number_or("max_adjacent_difference_deg", d.max_adjacent_difference_deg, Range::positive());
   g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", d.max_adjacent_sum_deg, Range::positive());
+  // Joint values the tracker and synth start from: within the limits, the
+  // defaults brought into limits set in the config.
   const Range limits = Range::closed(g.joint_min_deg, g.joint_max_deg);
-  g.unfolded_deg = t.number_or("unfolded_deg", d.unfolded_deg, limits);
-  g.folded_deg = t.number_or("folded_deg", d.folded_deg, limits);
+  g.unfolded_deg =
+      t.number_or("unfolded_deg", std::clamp(d.unfolded_deg, g.joint_min_deg, g.joint_max_deg), limits);
+  g.folded_deg = t.number_or("folded_deg", std::clamp(d.folded_deg, g.joint_min_deg, g.joint_max_deg), limits);
   return g;
 }
 
