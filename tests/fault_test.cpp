@@ -566,6 +566,22 @@ TEST(Fault, FollowedFolderTracksImagesAsTheyArriveAndEndsWhenTheyStop) {
   EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), want);
 }
 
+// Following a folder with --frames A:B: once frame B - 1 is taken there is
+// nothing left to wait for, and the run ends then, not --follow-input's
+// seconds later.
+TEST(Fault, AFollowedFolderEndsWithTheLastFrameOfTheRange) {
+  const fs::path dir = fresh_dir("follow_range");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = followed_run(write_frames(dir / "live", 6), dir, 120.0);
+  o.range = gtrack::parse_frame_range("0:6");
+  const auto start = std::chrono::steady_clock::now();
+  const auto s = gtrack::track_sequence(r.setup, r.config, o);
+  EXPECT_EQ(s.frames, 6);
+  EXPECT_FALSE(s.cancelled);
+  // Far below the 120 s it would otherwise wait, however loaded the machine.
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
+}
+
 // A followed folder as a camera's software writes JPEGs: one written in two
 // steps, with a pause well over a poll, is tracked once whole (a half JPEG
 // decodes, with a complaint); one that arrives after a later-named image

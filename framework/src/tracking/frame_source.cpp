@@ -380,7 +380,8 @@ class FolderSource final : public FrameSource {
         f.waited_s = waited_s_;
         return f;
       }
-      if (!following() || !wait_for_more()) return std::nullopt;
+      // The range's last frame taken: nothing to wait for.
+      if (!following() || filter_.done(index_) || !wait_for_more()) return std::nullopt;
     }
   }
   double fps() const override { return fps_; }
@@ -512,20 +513,38 @@ class FolderSource final : public FrameSource {
   // half-written JPEG: it is taken once it has been unchanged for two
   // seconds, by its size or its file time,
   // with a warning naming it). A cancel while waiting returns an empty image.
+  // The file is decoded again only once its size or file time has changed
+  // (a poll costs a stat, not a decode).
   cv::Mat read(const fs::path& p) const {
-    auto changed = std::chrono::steady_clock::now();
-    std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
-    for (;;) {
+    const auto decode = [&p](std::string& said) {
       detail::CapturedStderr library;
       cv::Mat img = cv::imread(p.string(), cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
-      const std::string said = library.take();
-      if (!following()) {
-        if (img.empty()) fail_to_read(p, said);
-        if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
-        return img;
-      }
-      std::error_code ec;
+      said = library.take();
+      return img;
+    };
+    std::string said;
+    if (!following()) {
+      cv::Mat img = decode(said);
+      if (img.empty()) fail_to_read(p, said);
+      if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
+      return img;
+    }
+    auto changed = std::chrono::steady_clock::now();
+    std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
+    cv::Mat img;
+    bool decoded = false;
+    std::uintmax_t decoded_size = 0;
+    fs::file_time_type decoded_time;
+    for (;;) {
+      std::error_code ec, ec_time;
       const std::uintmax_t size = fs::file_size(p, ec);
+      const fs::file_time_type written = fs::last_write_time(p, ec_time);
+      if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time) {
+        img = decode(said);
+        decoded = true;
+        decoded_size = size;
+        decoded_time = written;
+      }
       const auto now = std::chrono::steady_clock::now();
       const bool growing = !ec && size != last_size;
       if (growing) {
@@ -539,8 +558,8 @@ class FolderSource final : public FrameSource {
       // behind this one.
       const double unchanged_s = std::chrono::duration<double>(now - changed).count();
       const bool settled = unchanged_s > 2.0;
-      const auto written = fs::last_write_time(p, ec);
-      const bool old = !growing && !ec && fs::file_time_type::clock::now() - written > std::chrono::seconds(2);
+      const bool old =
+          !growing && !ec_time && fs::file_time_type::clock::now() - written > std::chrono::seconds(2);
       if (!img.empty() && (said.empty() || settled || old)) {
         if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
         return img;
