@@ -2,6 +2,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <cstdio>
 #include <iostream>
 #include <thread>
@@ -37,7 +38,10 @@ constexpr unsigned kStreamGraceS = 5;
 std::atomic<bool> g_streaming{false};
 std::atomic<bool> g_grace_over{false};
 std::atomic<bool> g_stream_stalled{false};  // a write failed after the grace
+std::atomic<bool> g_signalled{false};       // Ctrl-C, SIGTERM or SIGHUP came
+std::atomic<int> g_stream_errno{0};         // --stream: a write failed otherwise (a full disk)
 extern "C" void on_sigint(int) {
+  g_signalled.store(true);
   g_stop.store(true);
   if (g_streaming.load()) ::alarm(kStreamGraceS);
 }
@@ -96,7 +100,16 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     opt.on_frame = [](const gtrack::Estimate& e) {
       if (g_reader_gone || g_stream_stalled) return;
       if (std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
-        (g_grace_over && errno != EPIPE ? g_stream_stalled : g_reader_gone) = true;
+        const int error = errno;
+        if (g_grace_over && error != EPIPE) {
+          g_stream_stalled = true;
+        } else if (error != EPIPE) {
+          g_stream_errno = error;
+        } else if (!g_signalled) {
+          // (Ctrl-C on `gtrack ... --stream | controller` ends the reader
+          // too: that is an interrupt.)
+          g_reader_gone = true;
+        }
         g_stop = true;
       }
     };
@@ -143,7 +156,11 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const char* next = two_pass ? " (the same command with --resume instead of --two-pass continues the forward run)"
                      : opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
                                            : " (the same command with --resume continues)";
-  if (s.cancelled && g_stream_stalled) {
+  if (s.cancelled && g_stream_errno != 0) {
+    std::cerr << "gtrack track: --stream: writing to stdout failed (" << std::strerror(g_stream_errno)
+              << "); stopped after " << s.frames << (s.frames == 1 ? " frame" : " frames") << ", kept in "
+              << opt.out_dir.string() << next << "\n";
+  } else if (s.cancelled && g_stream_stalled) {
     std::cerr << "gtrack track: interrupted, and the reader of --stream took no line for " << kStreamGraceS
               << " s; stopped after " << s.frames << (s.frames == 1 ? " frame" : " frames") << ", kept in "
               << opt.out_dir.string() << next << "\n";
@@ -156,6 +173,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
               << " kept in " << opt.out_dir.string()
               << next << "\n";
   }
+  // No frame to track (said as a warning): the folder was left as it was.
+  if (s.frames == 0 && s.renderer.empty() && !s.cancelled) return 0;
   std::FILE* report = stream ? stderr : stdout;
   char cost[32] = "n/a (no frame found)";
   if (std::isfinite(s.mean_cost)) std::snprintf(cost, sizeof cost, "%.4f", s.mean_cost);
@@ -165,6 +184,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (s.resumed_after >= 0) {
     std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
   }
+  if (s.cancelled && g_stream_errno != 0) return 1;
   if (s.cancelled) return g_reader_gone ? 141 : 130;  // 141: as a process ended by SIGPIPE
   if (two_pass) {
     const gtrack::TwoPassSummary t = gtrack::two_pass(setup, config, opt, forward);

@@ -524,8 +524,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     const bool earlier = fs::exists(options.out_dir / "estimates.csv");
     if (clear_previous_run(options.out_dir) > 0 || earlier) {
-      logger().warn("{} holds an earlier run: it is replaced (--resume would have gone on with it)",
-                    options.out_dir.string());
+      logger().warn("{} holds an earlier run{}: it is replaced{}", options.out_dir.string(),
+                    options.resume ? " with no finished frame" : "",
+                    options.resume ? "" : " (--resume would have gone on with it)");
     }
   }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
