@@ -160,5 +160,23 @@ TEST(StimulusLog, AFollowedLogThatIsGoneIsSaidOnce) {
   std::ofstream(file) << text << "1,24.0\n";
   EXPECT_TRUE(log.poll());
   EXPECT_DOUBLE_EQ(*log.latest(), 24.0);
+  // A copy renamed over it (a logger that replaces its file) holding the
+  // rows read so far: its new rows are taken.
+  const fs::path copy = file.string() + ".new";
+  std::ofstream(copy) << text << "1,24.0\n2,25.5\n";
+  fs::rename(copy, file);
+  EXPECT_TRUE(log.poll());
+  EXPECT_DOUBLE_EQ(*log.latest(), 25.5);
+  // A new log, started afresh and as long by now: its rows are not the
+  // ones read, and reading on from the same byte would take a row's end.
+  fs::remove(file);
+  std::ofstream(file) << "frame,value\n0,30.0\n1,30.1\n2,30.2\n3,30.3\n";
+  try {
+    log.poll();
+    ADD_FAILURE() << "a new log in place of the followed one was read on from its old place";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("gtrack_stimulus_gone.csv: was replaced while followed"), std::string::npos)
+        << e.what();
+  }
   fs::remove(file);
 }

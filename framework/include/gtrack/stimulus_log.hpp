@@ -66,6 +66,9 @@ class GTRACK_API StimulusLog {
   std::filesystem::path followed_;       // follow(): the file
   std::streamoff read_to_ = 0;           // follow(): bytes taken (whole lines)
   bool gone_ = false;                    // follow(): the file is missing, and that was said
+  // follow(): the bytes just before read_to_, which the file (or one put in
+  // its place) must still hold.
+  std::string tail_;
 };
 
 }  // namespace gtrack

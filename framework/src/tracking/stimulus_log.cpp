@@ -148,6 +148,19 @@ bool StimulusLog::poll() {
     throw InputError(source_ + ": the stimulus log shrank while it was followed (from " + std::to_string(read_to_) +
                      " to " + std::to_string(size) + " bytes)");
   }
+  // Another file in its place (a logger that writes a copy and renames it
+  // over the log) goes on from the same byte only if it still holds the rows
+  // read so far: a new log, started afresh, is refused as a shrunk one is.
+  if (!tail_.empty()) {
+    std::string held(tail_.size(), '\0');
+    in.seekg(read_to_ - static_cast<std::streamoff>(tail_.size()));
+    in.read(held.data(), static_cast<std::streamsize>(held.size()));
+    if (in.gcount() != static_cast<std::streamsize>(held.size()) || held != tail_) {
+      throw InputError(source_ + ": was replaced while followed by a file that does not hold the rows read so far "
+                       "(a new log in place of the old one); a followed log may only grow");
+    }
+    in.clear();
+  }
   if (size == read_to_) return false;
   in.seekg(read_to_);
   std::string fresh(static_cast<size_t>(size - read_to_), '\0');
@@ -164,6 +177,8 @@ bool StimulusLog::poll() {
     start = nl + 1;
   }
   read_to_ += static_cast<std::streamoff>(end + 1);
+  tail_ = (tail_ + fresh.substr(0, end + 1));
+  if (tail_.size() > 256) tail_.erase(0, tail_.size() - 256);
   return keys_.size() > rows_before;
 }
 
