@@ -83,6 +83,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   opt.resume = vm.count("resume") > 0;
   opt.durable = vm.count("durable") > 0;
   opt.follow_stimulus = vm.count("follow-stimulus") > 0;
+  opt.newest = vm.count("newest") > 0;
   if (vm.count("restart-from")) opt.restart_from = vm["restart-from"].as<std::string>();
   if (vm.count("score-truth")) opt.score_truth = vm["score-truth"].as<std::string>();
   if (vm.count("follow-input")) {
@@ -123,8 +124,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
       throw gtrack::cli::UsageError("--two-pass needs a recording, not a live camera");
     }
     if (opt.resume) throw gtrack::cli::UsageError("--two-pass cannot be combined with --resume");
-    if (opt.follow_input_s > 0 || opt.follow_stimulus) {
-      throw gtrack::cli::UsageError("--two-pass cannot be combined with --follow-input or --follow-stimulus");
+    if (opt.follow_input_s > 0 || opt.follow_stimulus || opt.newest) {
+      throw gtrack::cli::UsageError("--two-pass cannot be combined with --follow-input, --follow-stimulus or --newest");
     }
     if (opt.restart_from) throw gtrack::cli::UsageError("--two-pass cannot be combined with --restart-from");
     opt.feed_untracked_readings = false;  // the backward pass replays the tracked frames' readings only
@@ -181,6 +182,9 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   std::fprintf(report, "%d frames (%d lost), mean cost %s, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
               s.frames, s.lost_frames, cost, s.mean_ms, s.mean_times.segment_ms, s.mean_times.pso_ms,
               s.mean_times.io_ms, s.renderer.c_str(), opt.out_dir.string().c_str());
+  if (s.skipped_frames > 0) {
+    std::fprintf(report, "%d frames left out for newer ones (--newest)\n", s.skipped_frames);
+  }
   if (s.resumed_after >= 0) {
     std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
   }
@@ -229,6 +233,9 @@ GTRACK_COMMAND(
                      "a power loss then loses no finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
           "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(
+          "newest",
+          "a live source (camera:N, --follow-input) faster than the tracker: track the newest frame each time, "
+          "leaving out those that came meanwhile, instead of tracking every frame further and further behind")(
           "follow-input", po::value<double>(),
           "SECONDS: the input folder is still being written: track new images as they arrive, end after SECONDS "
           "without one")(

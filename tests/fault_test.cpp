@@ -582,6 +582,39 @@ TEST(Fault, AFollowedFolderEndsWithTheLastFrameOfTheRange) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
 }
 
+// A live source faster than the tracker (here a followed folder that holds
+// twelve images at once, and a tracker slowed to 50 ms a frame): with
+// --newest each frame tracked is the newest read, the frames between are
+// left out and counted, and the last image is tracked; without it every
+// frame is, in order. A recording is refused.
+TEST(Fault, NewestTracksTheLatestFrameOfALiveSourceAndCountsTheRest) {
+  constexpr int kImages = 12;
+  const TrackRun r = make_run();
+  for (const bool newest : {true, false}) {
+    SCOPED_TRACE(newest ? "--newest" : "every frame");
+    const fs::path dir = fresh_dir(newest ? "newest" : "newest_off");
+    gtrack::TrackOptions o = followed_run(write_frames(dir / "live", kImages), dir, 0.5);
+    o.newest = newest;
+    o.on_frame = [](const gtrack::Estimate&) { std::this_thread::sleep_for(std::chrono::milliseconds(50)); };
+    const auto s = gtrack::track_sequence(r.setup, r.config, o);
+    const std::vector<int> rows = valid_rows(o.out_dir / "estimates.csv");
+    ASSERT_FALSE(rows.empty());
+    EXPECT_EQ(rows.back(), kImages - 1);
+    EXPECT_EQ(s.frames + s.skipped_frames, kImages);
+    EXPECT_EQ(static_cast<int>(rows.size()), s.frames);
+    if (newest) {
+      EXPECT_LT(s.frames, kImages / 2);
+    } else {
+      EXPECT_EQ(s.skipped_frames, 0);
+    }
+    EXPECT_NE(read_text(o.out_dir / "summary.json").find("\"skipped_frames\": " + std::to_string(s.skipped_frames)),
+              std::string::npos);
+  }
+  gtrack::TrackOptions recording = folder_run(fresh_dir("newest_recording"), 3);
+  recording.newest = true;
+  expect_refusal_naming(track_error(r, recording), "--newest is for a live source");
+}
+
 // A followed folder as a camera's software writes JPEGs: one written in two
 // steps, with a pause well over a poll, is tracked once whole (a half JPEG
 // decodes, with a complaint); one that arrives after a later-named image

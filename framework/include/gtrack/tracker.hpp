@@ -198,6 +198,12 @@ struct TrackOptions {
   // images as they come): new images are tracked as they arrive, and the
   // run ends after this many seconds without one (0: not followed).
   double follow_input_s = 0;
+  // A live source (a camera, a followed folder) faster than the tracker:
+  // each frame tracked is the newest one read, and the frames that came
+  // while the tracker was busy are left out (counted in the summary's
+  // skipped_frames) instead of queueing up behind it, the estimates falling
+  // ever further behind the images. Refused for a recording.
+  bool newest = false;
   // A pose table (ground_truth.csv, or another run's estimates.csv): before
   // each frame the track is set to the table's row for the range's previous
   // frame, so each estimate is one frame of tracking from that row. With the
@@ -228,6 +234,7 @@ struct TrackSummary {
   int resumed_after = -1;    // --resume: the last frame done before this run (-1: a fresh run)
   int frames_before = 0;     // --resume: rows kept from before; `frames` counts this run's only
   std::string input_ended_early;  // FrameSource::ended_early: "" when the input ended where it said it would
+  int skipped_frames = 0;    // TrackOptions::newest: frames read and left out for a newer one
   std::string stopped_by;    // the error that stopped the run part way ("" when none; it is then thrown on)
 };
 

@@ -40,6 +40,22 @@ class Handoff {
     return true;
   }
 
+  // As push(), but a full queue has its newest item replaced instead of
+  // being waited on. `replaced`: whether one was.
+  bool push_over(T item, bool& replaced) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    replaced = false;
+    if (closed_) return false;
+    if (items_.size() >= capacity_) {
+      items_.back() = std::move(item);
+      replaced = true;
+    } else {
+      items_.push_back(std::move(item));
+    }
+    ready_.notify_one();
+    return true;
+  }
+
   // `tick`, when given, is called every 50 ms of waiting (without the lock).
   std::optional<T> pop(const std::function<void()>& tick = {}) {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -81,10 +97,14 @@ class Handoff {
 // is raised when `cancel` is, while the tracker waits for a frame, and when
 // the reader is stopped. The source's fps, length and description do not
 // change as it is read; ended_early() is read once stop() has returned.
+// `newest`: the reader does not wait for the tracker; a frame read while the
+// one before it is still waiting takes its place (a live source faster than
+// the tracker: the tracker then always gets the newest frame, and the frames
+// left out are counted in skipped()).
 class ReadAhead {
  public:
-  ReadAhead(FrameSource& source, std::atomic<bool>& halt, const std::atomic<bool>* cancel)
-      : source_(source), halt_(halt), cancel_(cancel), thread_([this] { run(); }) {}
+  ReadAhead(FrameSource& source, std::atomic<bool>& halt, const std::atomic<bool>* cancel, bool newest = false)
+      : source_(source), halt_(halt), cancel_(cancel), newest_(newest), thread_([this] { run(); }) {}
   ~ReadAhead() { stop(); }
   ReadAhead(const ReadAhead&) = delete;
   ReadAhead& operator=(const ReadAhead&) = delete;
@@ -109,6 +129,9 @@ class ReadAhead {
     if (thread_.joinable()) thread_.join();
   }
 
+  // Frames read and left out for a newer one (`newest`).
+  int skipped() const { return skipped_.load(); }
+
  private:
   struct Item {
     std::optional<Frame> frame;
@@ -124,7 +147,12 @@ class ReadAhead {
         item.error = std::current_exception();
       }
       const bool last = !item.frame;
-      if (!queue_.push(std::move(item)) || last) break;
+      // The end and an error wait their turn: they never take a frame's place.
+      bool replaced = false;
+      if (!(newest_ && !last ? queue_.push_over(std::move(item), replaced) : queue_.push(std::move(item))) || last) {
+        break;
+      }
+      if (replaced) skipped_.fetch_add(1);
     }
     queue_.close();
   }
@@ -132,6 +160,8 @@ class ReadAhead {
   FrameSource& source_;
   std::atomic<bool>& halt_;
   const std::atomic<bool>* cancel_;
+  const bool newest_;
+  std::atomic<int> skipped_{0};
   Handoff<Item> queue_{1};
   std::thread thread_;  // last: started once the rest is set up
 };

@@ -204,6 +204,7 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
       << "  \"resumed_after_frame\": " << (s.resumed_after >= 0 ? std::to_string(s.resumed_after) : "null") << ",\n"
       << "  \"frames_before_resume\": " << s.frames_before << ",\n"
       << "  \"cancelled\": " << (s.cancelled ? "true" : "false") << ",\n"
+      << "  \"skipped_frames\": " << s.skipped_frames << ",\n"
       << "  \"input_ended_early\": " << (s.input_ended_early.empty() ? "null" : json_string(s.input_ended_early))
       << ",\n"
       << "  \"stopped_by\": " << (s.stopped_by.empty() ? "null" : json_string(s.stopped_by)) << "\n"

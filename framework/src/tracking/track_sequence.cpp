@@ -372,6 +372,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   const fs::path state_file = options.out_dir / "tracker_state.txt";
   std::optional<TrackerState> resumed;
   FrameRange range = options.range;
+  if (options.newest && options.input.rfind("camera:", 0) != 0 && !(options.follow_input_s > 0)) {
+    throw InputError("--newest is for a live source (camera:N, or a folder followed with --follow-input), not " +
+                     options.input + ", whose frames are all there to be tracked");
+  }
   if (options.resume && options.input.rfind("camera:", 0) == 0) {
     throw InputError("--resume continues a video or a folder of images, not a live camera (" + options.input + ")");
   }
@@ -477,7 +481,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // replaced: an input that fails at once (another image size, a video
   // that does not decode) leaves that run as it was, and so does a
   // followed folder that never gets an image.
-  detail::ReadAhead reader(*source, halt_reading, options.cancel);
+  detail::ReadAhead reader(*source, halt_reading, options.cancel, options.newest);
   std::optional<Frame> pending;
   double pending_read_s = 0;
   if (!resumed) {
@@ -599,6 +603,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const int found = summary.frames - summary.lost_frames;
     summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
     summary.input_ended_early = source->ended_early();
+    summary.skipped_frames = reader.skipped();
     summary.mean_ms = ms_sum / n;
     summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
     summary.wall_s = seconds_since(start);
