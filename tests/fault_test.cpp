@@ -801,6 +801,37 @@ TEST(Fault, OutputFolderRemovedMidRunStopsAtTheNextFrame) {
   EXPECT_EQ(frames_run, 3);
 }
 
+// A folder's images are numbered by their place in name order: with the
+// first images moved away (done with, as acquisition scripts do), the ones
+// left would be tracked under other numbers. Resuming is refused, naming
+// the last frame done and both images; with the folder as it was, it goes on.
+TEST(Fault, ResumeRefusesAFolderWhoseImagesMovedUnderTheFramesDone) {
+  const fs::path dir = fresh_dir("resume_moved");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  std::atomic<bool> cancel{false};
+  o.cancel = &cancel;
+  int done = 0;
+  o.on_frame = [&](const gtrack::Estimate&) {
+    if (++done == 4) cancel = true;
+  };
+  ASSERT_TRUE(gtrack::track_sequence(r.setup, r.config, o).cancelled);
+  const fs::path moved = dir / "moved";
+  fs::create_directories(moved);
+  for (const char* name : {"000000.png", "000001.png"}) fs::rename(fs::path(o.input) / name, moved / name);
+  gtrack::TrackOptions again = o;
+  again.resume = true;
+  again.on_frame = nullptr;
+  again.cancel = nullptr;
+  const std::string e = track_error(r, again);
+  expect_refusal_naming(e, "frame 3 was \"" + (fs::path(o.input) / "000003.png").string() + "\"");
+  EXPECT_NE(e.find("is now \"" + (fs::path(o.input) / "000005.png").string() + "\""), std::string::npos) << e;
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), (std::vector<int>{0, 1, 2, 3}));
+  for (const char* name : {"000000.png", "000001.png"}) fs::rename(moved / name, fs::path(o.input) / name);
+  EXPECT_EQ(track_error(r, again), "");
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv").size(), static_cast<size_t>(kFrames));
+}
+
 // estimates.csv without the ms column (the one field that is not
 // reproducible): the rows a resumed run must reproduce exactly.
 std::vector<std::string> rows_without_time(const fs::path& csv) {

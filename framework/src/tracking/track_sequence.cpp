@@ -273,6 +273,43 @@ class ObservationAdvice {
 
 namespace {
 
+// Resuming a folder: its images are numbered by their place in name order,
+// so images removed, added or renamed before the frames done would give the
+// resumed frames other images under the numbers the run goes on with. The
+// last frame done must still be the image its row names.
+void check_resumed_folder(const TrackOptions& options, ImageSize size, double fps, int frame) {
+  std::error_code ec;
+  if (!fs::is_directory(options.input, ec)) return;  // a video or a stack: its frames are its own
+  std::ifstream in(options.out_dir / "estimates.jsonl", std::ios::binary);
+  const std::string head = "{\"frame\":" + std::to_string(frame) + ",";
+  std::string line, row;
+  while (std::getline(in, line)) {
+    if (line.rfind(head, 0) == 0) row = line;
+  }
+  const std::string key = ",\"image\":";
+  const size_t at = row.find(key);
+  if (at == std::string::npos) return;  // a row written before rows named their image
+  FrameRange one;
+  one.first = frame;
+  one.last = frame + 1;
+  auto probe = open_frame_source(options.input, size, one, fps);
+  probe->set_quiet();
+  const std::optional<Frame> now = probe->next();
+  if (now) {
+    const std::string named = key + json_string(now->name);
+    const size_t end = at + named.size();
+    if (row.compare(at, named.size(), named) == 0 && end < row.size() && (row[end] == ',' || row[end] == '}')) return;
+  }
+  // The row's name as written: a JSON string, to its closing quote.
+  size_t close = at + key.size() + 1;
+  while (close < row.size() && row[close] != '"') close += row[close] == '\\' ? 2 : 1;
+  const std::string was = row.substr(at + key.size(), close + 1 - (at + key.size()));
+  throw InputError(options.input + ": frame " + std::to_string(frame) + " was " + was + " in the interrupted run, " +
+                   (now ? "is now " + json_string(now->name) : std::string("is now past the folder's last image")) +
+                   " (images removed, added or renamed before it); cannot resume, the frames would be numbered "
+                   "otherwise (put the images back as they were, or start a new run with another --out)");
+}
+
 // An exclusive lock on an output folder (flock on DIR/.gtrack_lock, which
 // holds the owner's pid), held while a run writes there.
 class OutputLock {
@@ -429,6 +466,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                                   FollowOptions{options.follow_input_s, &halt_reading});
   source->set_image_bits(config.tracker.image_bits);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
+  if (resumed) check_resumed_folder(options, setup.sensor->image_size(), fps, resumed->frame);
   if (config.tracker.fps > 0 && source->fps() > 0 && std::abs(source->fps() / config.tracker.fps - 1) > 0.01) {
     // A video's own rate set aside: its frame times, a time_s log and the
     // stimulus's response run on the config's.
