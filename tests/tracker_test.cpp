@@ -456,6 +456,12 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   EXPECT_GT(written, now - 600);
   EXPECT_LE(written, now);
+  // Read before it was tracked and written.
+  const auto read_at = jsonl[4].find("\"read_unix_s\":");
+  ASSERT_NE(read_at, std::string::npos) << jsonl[4];
+  const double read = std::stod(jsonl[4].substr(read_at + 14));
+  EXPECT_GT(read, now - 600);
+  EXPECT_LE(read, written);
   EXPECT_TRUE(fs::exists(opt.out_dir / "summary.json"));
   EXPECT_TRUE(fs::exists(opt.out_dir / "masks" / "000004.png"));
   EXPECT_FALSE(s.overlay_file.empty());

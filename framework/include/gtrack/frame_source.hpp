@@ -34,6 +34,9 @@ struct Frame {
   // Following a folder: the time spent waiting for the image to arrive and
   // to be written whole, which is the camera's, not reading.
   double waited_s = 0;
+  // When it had been read, seconds since the Unix epoch (set by the reader
+  // of gtrack track; 0 otherwise).
+  double read_unix_s = 0;
 };
 
 // A half-open range [first, last) of frame indices; last < 0 = to the end.

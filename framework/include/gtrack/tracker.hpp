@@ -92,10 +92,13 @@ struct Estimate {
   StageTimes times;
   double ms = 0;  // segment + PSO (the tracker's own time for the frame)
   // Set by track_sequence(): the image the frame came from (an image's
-  // path, "<video> frame N") and when its estimate was written (seconds
-  // since the Unix epoch, this machine's clock), for matching a streamed
-  // estimate with its image and measuring the delay; "" and 0 otherwise.
+  // path, "<video> frame N"), when it had been read (decoded: for a live
+  // source, about when it arrived) and when its estimate was written
+  // (seconds since the Unix epoch, this machine's clock), for matching a
+  // streamed estimate with its image and measuring the delay; "" and 0
+  // otherwise.
   std::string image;
+  double read_unix_s = 0;
   double unix_time_s = 0;
 };
 

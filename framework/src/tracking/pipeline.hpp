@@ -143,6 +143,10 @@ class ReadAhead {
       Item item;
       try {
         item.frame = source_.next();
+        if (item.frame) {
+          item.frame->read_unix_s =
+              std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+        }
       } catch (...) {
         item.error = std::current_exception();
       }

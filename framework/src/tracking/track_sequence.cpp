@@ -696,6 +696,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const auto t_write = Clock::now();
       e.times.io_ms = io_ms;
       e.image = frame->name;
+      e.read_unix_s = frame->read_unix_s;
       e.unix_time_s =
           std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
       results.write(e);
