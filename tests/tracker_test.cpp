@@ -934,9 +934,10 @@ TEST(Tracker, MirrorCheckLeavesTheMirrorTilt) {
   EXPECT_LT(p.hypothesis[3], 0.0) << p.hypothesis.transpose();
 }
 
-// The turned tilt of re-detection's searches: the tilt (rx, ry) turned in
-// its plane, the rest of the configuration unchanged; 180 deg is the mirror.
-TEST(Model, TiltTurnedKeepsTheTiltAndTheRest) {
+// The turned tilt of re-detection's searches: the Euler pair (rx, ry)
+// turned in its plane, the rest of the configuration unchanged; 180 deg is
+// the mirror.
+TEST(Model, TiltTurnedTurnsTheEulerPairAndKeepsTheRest) {
   Eigen::VectorXd h = pose(0.3, -0.2, 20, 40);
   h[3] = 30;
   h[4] = 10;

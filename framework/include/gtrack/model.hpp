@@ -135,9 +135,13 @@ GTRACK_API Eigen::Matrix3d rotation_from_euler_deg(double rx, double ry, double 
 // Inverse of the above (rx, ry, rz in degrees).
 GTRACK_API Eigen::Vector3d euler_deg_from_rotation(const Eigen::Matrix3d& r);
 
-// h (x, y, z, rx, ry, rz, joints...) with its tilt (rx, ry) turned by `deg`
-// in the (rx, ry) plane, the rest unchanged: as much tilt, in another
-// direction; 180 is the tilt mirror (-rx, -ry).
+// h (x, y, z, rx, ry, rz, joints...) with its Euler pair (rx, ry) turned
+// by `deg` in its own plane, rz and the rest unchanged: about as much tilt,
+// its direction turned about as much, the fingers' heading in the image
+// kept. Exact at 180 (the tilt mirror, -rx, -ry); elsewhere the pair is not
+// the tilt itself (rx = 60 turned by 60 tilts the palm 57.75 deg, its
+// direction turned by 53.8). Re-detection's turned starts are this; the
+// exact turn of the palm normal tracked worse (docs/tracker.md).
 GTRACK_API Eigen::VectorXd tilt_turned(const Eigen::VectorXd& h, double deg);
 
 // A regular-polygon gripper with identical fingers on every palm edge: the
