@@ -18,6 +18,7 @@
 #include "gtrack/log.hpp"
 #include "gtrack/results.hpp"
 #include "nearest_equivalent.hpp"
+#include "pipeline.hpp"
 
 namespace gtrack {
 
@@ -255,6 +256,9 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
   source->set_image_bits(config.tracker.image_bits);
   source->set_quiet();
+  // Read a frame ahead, on a thread of its own, as the forward run was.
+  std::atomic<bool> halt_reading{false};
+  detail::ReadAhead reader(*source, halt_reading, options.cancel);
   constexpr double kNone = std::numeric_limits<double>::infinity();
   // Per frame, the costs of the two candidates (0 the forward estimate, 1
   // the backward one) on the forward run's conditions, temporal term aside.
@@ -273,7 +277,8 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
       summary.cancelled = true;
       break;
     }
-    auto frame = source->next();
+    double waited_s = 0;
+    auto frame = reader.next(waited_s);
     if (frame && frame->index < forward[k].frame) continue;
     if (!frame || frame->index != forward[k].frame) {
       throw InputError(options.input + ": frame " + std::to_string(forward[k].frame) +
