@@ -375,13 +375,18 @@ TEST(CpuRenderer, SlabOfTwoClipPlanesKeepsOnlyWhatIsInside) {
   }
 }
 
+// A six-finger radial gripper of one link per finger.
+ArticulatedModel radial_model(double palm_circumradius_mm, const gtrack::LinkShape& link) {
+  gtrack::RadialGripperSpec s;
+  s.name = "radial";
+  s.palm_circumradius_mm = palm_circumradius_mm;
+  s.links = {link};
+  return ArticulatedModel(gtrack::make_radial_gripper(s));
+}
+
 TEST(CpuRenderer, AGripperLargerThanTheImageCoversEveryPixel) {
   // Vertices far outside the image go through the guard band.
-  gtrack::RadialGripperSpec s;
-  s.name = "huge";
-  s.palm_circumradius_mm = 50;
-  s.links = {{10, 5, 5}};
-  const ArticulatedModel m(gtrack::make_radial_gripper(s));
+  const ArticulatedModel m = radial_model(50, {10, 5, 5});
   auto r = cpu(m, camera(), kScale, 1);
   Eigen::VectorXd h = Eigen::VectorXd::Zero(12);
   h[2] = 5;
@@ -396,11 +401,7 @@ TEST(CpuRenderer, AGripperLargerThanTheImageCoversEveryPixel) {
 // them inside the frustum, nor reach the rasteriser's integer snapping (run
 // under the sanitizers in CI).
 TEST(CpuRenderer, AConfigurationAbsurdlyFarShowsNothing) {
-  gtrack::RadialGripperSpec s;
-  s.name = "six";
-  s.palm_circumradius_mm = 1;
-  s.links = {{0.5, 0.4, 0.2}};
-  const ArticulatedModel m(gtrack::make_radial_gripper(s));
+  const ArticulatedModel m = radial_model(1, {0.5, 0.4, 0.2});
   auto r = cpu(m, camera(), kScale, 1);
   Eigen::VectorXd h = Eigen::VectorXd::Zero(12);
   h[2] = 34;
