@@ -289,6 +289,10 @@ void check_resumed_folder(const TrackOptions& options, ImageSize size, double fp
   const std::string key = ",\"image\":";
   const size_t at = row.find(key);
   if (at == std::string::npos) return;  // a row written before rows named their image
+  // The row's name as written: a JSON string, to its closing quote.
+  size_t close = at + key.size() + 1;
+  while (close < row.size() && row[close] != '"') close += row[close] == '\\' ? 2 : 1;
+  const std::string was = row.substr(at + key.size(), close + 1 - (at + key.size()));
   FrameRange one;
   one.first = frame;
   one.last = frame + 1;
@@ -296,14 +300,14 @@ void check_resumed_folder(const TrackOptions& options, ImageSize size, double fp
   probe->set_quiet();
   const std::optional<Frame> now = probe->next();
   if (now) {
-    const std::string named = key + json_string(now->name);
-    const size_t end = at + named.size();
-    if (row.compare(at, named.size(), named) == 0 && end < row.size() && (row[end] == ',' || row[end] == '}')) return;
+    // By file name: the folder itself may be given another way (relative,
+    // absolute) on resuming.
+    const std::string name = json_string(fs::path(now->name).filename().string()).substr(1);  // name"
+    if (was.size() > name.size() && was.compare(was.size() - name.size(), name.size(), name) == 0 &&
+        (was[was.size() - name.size() - 1] == '/' || was.size() == name.size() + 1)) {
+      return;
+    }
   }
-  // The row's name as written: a JSON string, to its closing quote.
-  size_t close = at + key.size() + 1;
-  while (close < row.size() && row[close] != '"') close += row[close] == '\\' ? 2 : 1;
-  const std::string was = row.substr(at + key.size(), close + 1 - (at + key.size()));
   throw InputError(options.input + ": frame " + std::to_string(frame) + " was " + was + " in the interrupted run, " +
                    (now ? "is now " + json_string(now->name) : std::string("is now past the folder's last image")) +
                    " (images removed, added or renamed before it); cannot resume, the frames would be numbered "
