@@ -147,10 +147,13 @@ class VideoSource final : public FrameSource {
       double stamp_ms = -1;
       bool grabbed = false;
       {
-        detail::CapturedStderr decoder;
+        // Not for a camera: its grab waits for the next frame, and fd 2 would
+        // be taken aside from the whole process most of the time.
+        std::optional<detail::CapturedStderr> decoder;
+        if (!live_) decoder.emplace();
         grabbed = cap_.grab();
         if (grabbed) stamp_ms = cap_.get(cv::CAP_PROP_POS_MSEC);
-        said = decoder.take();
+        if (decoder) said = decoder->take();
       }
       if (!grabbed) return end_of_stream(said);
       follow_time_stamp(stamp_ms);
@@ -163,9 +166,12 @@ class VideoSource final : public FrameSource {
       cv::Mat img;
       bool decoded = false;
       {
-        detail::CapturedStderr decoder;
+        std::optional<detail::CapturedStderr> decoder;
+        if (!live_) decoder.emplace();
         decoded = cap_.retrieve(img) && !img.empty();
-        if (const std::string more = decoder.take(); !more.empty()) said += (said.empty() ? "" : "; ") + more;
+        if (const std::string more = decoder ? decoder->take() : std::string(); !more.empty()) {
+          said += (said.empty() ? "" : "; ") + more;
+        }
       }
       if (!decoded) return end_of_stream(said);
       note(said, true);
@@ -535,15 +541,20 @@ class FolderSource final : public FrameSource {
     bool decoded = false;
     std::uintmax_t decoded_size = 0;
     fs::file_time_type decoded_time;
+    auto decoded_at = std::chrono::steady_clock::now();
     for (;;) {
       std::error_code ec, ec_time;
       const std::uintmax_t size = fs::file_size(p, ec);
       const fs::file_time_type written = fs::last_write_time(p, ec_time);
-      if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time) {
+      // Also every 2 s: a writer that set the size first, on a file system
+      // whose file times step by seconds, changes neither as it fills.
+      if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time ||
+          std::chrono::steady_clock::now() - decoded_at > std::chrono::seconds(2)) {
         img = decode(said);
         decoded = true;
         decoded_size = size;
         decoded_time = written;
+        decoded_at = std::chrono::steady_clock::now();
       }
       const auto now = std::chrono::steady_clock::now();
       const bool growing = !ec && size != last_size;

@@ -92,7 +92,8 @@ class Handoff {
   bool closed_ = false;
 };
 
-// A frame source read one frame ahead, on a thread of its own. `halt` is the
+// A frame source read ahead on a thread of its own: one frame waiting for
+// the tracker, the next being read. `halt` is the
 // flag the source was opened to stop waiting at (FollowOptions::cancel): it
 // is raised when `cancel` is, while the tracker waits for a frame, and when
 // the reader is stopped. The source's fps, length and description do not
@@ -204,8 +205,9 @@ class Behind {
         consume_(*item);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex_);
-        error_ = std::current_exception();
+        if (!error_) error_ = std::current_exception();
         queue_.close();
+        return;  // what is still queued is dropped with the queue
       }
     }
   }

@@ -256,7 +256,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range, fps);
   source->set_image_bits(config.tracker.image_bits);
   source->set_quiet();
-  // Read a frame ahead, on a thread of its own, as the forward run was.
+  // Read ahead, on a thread of its own, as the forward run was.
   std::atomic<bool> halt_reading{false};
   detail::ReadAhead reader(*source, halt_reading, options.cancel);
   constexpr double kNone = std::numeric_limits<double>::infinity();
