@@ -583,13 +583,16 @@ TEST(TrackCommand, SigintWithAStalledStreamReaderStops) {
     _exit(127);
   }
   ::close(pipe_fds[1]);  // the pipe is never read: it fills, and the run's write blocks
-  // Wait until the rows stop growing: the write is blocked.
+  // Wait until the rows stop growing for 3 s: the write is blocked (a frame
+  // takes a quarter of a second under the sanitizers on a loaded machine).
   size_t rows = 0;
+  int still = 0;
   const auto t0 = std::chrono::steady_clock::now();
   for (;;) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     const size_t now = lines(out / "estimates.csv").size();
-    if ((now == rows && now > 1) || std::chrono::steady_clock::now() - t0 > std::chrono::seconds(60)) break;
+    still = now == rows && now > 1 ? still + 1 : 0;
+    if (still == 6 || std::chrono::steady_clock::now() - t0 > std::chrono::seconds(120)) break;
     rows = now;
   }
   ASSERT_LT(rows, 301u) << "the run ended before its stream's pipe filled";
