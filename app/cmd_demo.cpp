@@ -69,8 +69,9 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
             << ev.lost_frames << " lost, " << ev.out_of_view_frames << " out of view), N=" << cfg.pso.particles
             << " G=" << cfg.pso.generations << ", " << track.renderer << " renderer, "
             << (track.mean_ms > 0 ? 1000.0 / track.mean_ms : 0.0)
-            << " frames/s of tracking (segmentation and search; "
-            << (track.wall_s > 0 ? track.frames / track.wall_s : 0.0) << " frames/s with reading and writing):\n"
+            << " frames/s of tracking (segmentation and search, sharing the cores with the reading and drawing "
+               "threads; "
+            << (track.wall_s > 0 ? track.frames / track.wall_s : 0.0) << " frames/s end to end):\n"
             << "  position in-plane " << e.position_inplane_um.mean << " +- " << e.position_inplane_um.std
             << " um   (paper: 25 +- 7 um)\n"
             << "  depth             " << e.depth_um.mean << " +- " << e.depth_um.std << " um\n"
