@@ -636,11 +636,14 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   ObservationAdvice advice(config.observation);
   // The files closed and the summary's figures taken, at the end or at an
   // error that stops the run.
+  // Once: the figures first, so that an error closing a file (the
+  // overlay's encoder) still leaves them to the summary.
+  bool finished = false;
   const auto finish = [&] {
+    if (finished) return;
+    finished = true;
     progress.finish();
     reader.stop();
-    results.close();
-    overlay.close();
     const int n = std::max(1, summary.frames);
     const int found = summary.frames - summary.lost_frames;
     summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
@@ -649,6 +652,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     summary.mean_ms = ms_sum / n;
     summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
     summary.wall_s = seconds_since(start);
+    results.close();
+    overlay.close();
     summary.overlay_file = overlay.file();
   };
   try {
@@ -727,6 +732,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       sums.io_ms += io_ms;
       progress.update(summary.frames, frame->index, seconds_since(start));
     }
+    finish();
   } catch (const std::exception& e) {
     // An error part way (an unreadable image, a log that shrank): the
     // frames done stay, the summary says what stopped the run, and the
@@ -735,7 +741,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     std::string kept;
     try {
       summary.stopped_by = e.what();
-      finish();
+      try {
+        finish();
+      } catch (const std::exception&) {
+        // A second error closing the files: the first is the one to report.
+      }
       // A resumed run that stops at its first frame leaves the earlier
       // run's summary as it was.
       if (summary.frames > 0) write_summary(options.out_dir / "summary.json", summary);
@@ -750,7 +760,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (!kept.empty() && dynamic_cast<const InputError*>(&e)) throw InputError(e.what() + kept);
     throw;
   }
-  finish();
   // A table of other frames (renumbered, another sequence's) changes nothing: said.
   const auto warn_unused = [&](const std::optional<std::filesystem::path>& file, const std::map<int, Eigen::VectorXd>& rows,
                                int used, const char* option, const char* matched) {
