@@ -93,10 +93,10 @@ class Handoff {
 };
 
 // A frame source read ahead on a thread of its own: one frame waiting for
-// the tracker, the next being read. `halt` is the
-// flag the source was opened to stop waiting at (FollowOptions::cancel): it
-// is raised when `cancel` is, while the tracker waits for a frame, and when
-// the reader is stopped. The source's fps, length and description do not
+// the tracker, the next being read. `halt` is the flag the source was
+// opened to stop waiting at (FollowOptions::cancel): it is raised when
+// `cancel` is, while the tracker waits for a frame, and when the reader is
+// stopped. The source's fps, length and description do not
 // change as it is read; ended_early() is read once stop() has returned.
 // `newest`: the reader does not wait for the tracker; a frame read while the
 // one before it is still waiting takes its place (a live source faster than
