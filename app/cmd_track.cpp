@@ -157,18 +157,18 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const char* next = two_pass ? " (the same command with --resume instead of --two-pass continues the forward run)"
                      : opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
                                            : " (the same command with --resume continues)";
-  if (s.cancelled && g_stream_errno != 0) {
-    std::cerr << "gtrack track: --stream: writing to stdout failed (" << std::strerror(g_stream_errno)
-              << "); stopped after " << s.frames << (s.frames == 1 ? " frame" : " frames") << ", kept in "
-              << opt.out_dir.string() << next << "\n";
-  } else if (s.cancelled && g_stream_stalled) {
-    std::cerr << "gtrack track: interrupted, and the reader of --stream took no line for " << kStreamGraceS
-              << " s; stopped after " << s.frames << (s.frames == 1 ? " frame" : " frames") << ", kept in "
-              << opt.out_dir.string() << next << "\n";
-  } else if (s.cancelled && g_reader_gone) {
-    std::cerr << "gtrack track: stdout was closed by its reader; stopped after " << s.frames
-              << (s.frames == 1 ? " frame" : " frames") << ", kept in "
-              << opt.out_dir.string() << next << "\n";
+  // Why the stream stopped the run ("" when it did not).
+  std::string stream_stop;
+  if (g_stream_errno != 0) {
+    stream_stop = std::string("--stream: writing to stdout failed (") + std::strerror(g_stream_errno) + ")";
+  } else if (g_stream_stalled) {
+    stream_stop = "interrupted, and the reader of --stream took no line for " + std::to_string(kStreamGraceS) + " s";
+  } else if (g_reader_gone) {
+    stream_stop = "stdout was closed by its reader";
+  }
+  if (s.cancelled && !stream_stop.empty()) {
+    std::cerr << "gtrack track: " << stream_stop << "; stopped after " << s.frames
+              << (s.frames == 1 ? " frame" : " frames") << ", kept in " << opt.out_dir.string() << next << "\n";
   } else if (s.cancelled) {
     std::cerr << "gtrack track: interrupted; " << s.frames << (s.frames == 1 ? " finished frame" : " finished frames")
               << " kept in " << opt.out_dir.string()
