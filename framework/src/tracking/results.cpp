@@ -43,7 +43,6 @@ size_t utf8_length(const std::string& text, size_t i) {
   return n;
 }
 
-
 std::ofstream open_for_writing(const fs::path& p, bool append) {
   errno = 0;
   std::ofstream out(p, append ? std::ios::app : std::ios::trunc);

@@ -302,10 +302,11 @@ void check_resumed_folder(const TrackOptions& options, ImageSize size, double fp
   if (now) {
     // By file name: the folder itself may be given another way (relative,
     // absolute) on resuming.
+    // The row's name ends in this one's, after the folder's '/' or the opening quote.
     const std::string name = json_string(fs::path(now->name).filename().string()).substr(1);  // name"
-    if (was.size() > name.size() && was.compare(was.size() - name.size(), name.size(), name) == 0 &&
-        (was[was.size() - name.size() - 1] == '/' || was.size() == name.size() + 1)) {
-      return;
+    if (was.size() > name.size() && was.compare(was.size() - name.size(), name.size(), name) == 0) {
+      const char before = was[was.size() - name.size() - 1];
+      if (before == '/' || before == '"') return;
     }
   }
   throw InputError(options.input + ": frame " + std::to_string(frame) + " was " + was + " in the interrupted run, " +
@@ -634,10 +635,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   StageTimes sums;
   int previous_index = -1;  // the last frame tracked by this run
   ObservationAdvice advice(config.observation);
-  // The files closed and the summary's figures taken, at the end or at an
-  // error that stops the run.
-  // Once: the figures first, so that an error closing a file (the
-  // overlay's encoder) still leaves them to the summary.
+  // The summary's figures taken and the files closed, once, at the end or
+  // at an error that stops the run: the figures first, so that an error
+  // closing a file (the overlay's encoder) still leaves them to the summary.
   bool finished = false;
   const auto finish = [&] {
     if (finished) return;
