@@ -5,6 +5,7 @@
 #include <cstring>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <thread>
 
 #include <poll.h>
@@ -119,6 +120,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   // pass that follows the forward one.
   const bool two_pass = vm.count("two-pass") > 0;
   std::vector<gtrack::Estimate> forward;
+  std::optional<gtrack::OutputLock> held;
   if (two_pass) {
     if (opt.input.rfind("camera:", 0) == 0) {
       throw gtrack::cli::UsageError("--two-pass needs a recording, not a live camera");
@@ -129,7 +131,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     }
     if (opt.restart_from) throw gtrack::cli::UsageError("--two-pass cannot be combined with --restart-from");
     opt.feed_untracked_readings = false;  // the backward pass replays the tracked frames' readings only
-    opt.on_frame = [&forward, streamed = opt.on_frame](const gtrack::Estimate& e) {
+    // The folder's lock, taken again at the forward run's first estimate
+    // (within track_sequence's own), is held through the backward pass.
+    opt.on_frame = [&forward, &held, &out_dir = opt.out_dir, streamed = opt.on_frame](const gtrack::Estimate& e) {
+      if (!held) held.emplace(out_dir);
       if (streamed) streamed(e);
       forward.push_back(e);
     };

@@ -450,6 +450,29 @@ TEST(Fault, ASecondRunIntoABusyFolderIsRefused) {
   EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 2);
 }
 
+// One process takes its folder's lock again (gtrack track --two-pass holds
+// it from the forward run through the backward pass): the run goes on, and
+// the folder stays locked to other processes until the last holder ends.
+TEST(Fault, AnOutputLockIsTakenAgainWithinAProcessAndHeldUntilTheLastRelease) {
+  const fs::path dir = fresh_dir("relocked");
+  const TrackRun r = make_run();
+  const gtrack::TrackOptions o = folder_run(dir, 2);
+  const auto others_can_lock = [&] {
+    const int fd = ::open((o.out_dir / ".gtrack_lock").c_str(), O_RDWR);
+    const bool free = fd >= 0 && ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    if (fd >= 0) ::close(fd);
+    return free;
+  };
+  {
+    const gtrack::OutputLock outer(o.out_dir);
+    EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 2);
+    EXPECT_FALSE(others_can_lock()) << "the run's end released the lock its caller holds";
+    std::ifstream pid(o.out_dir / ".gtrack_lock");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(pid), {}), std::to_string(::getpid()));
+  }
+  EXPECT_TRUE(others_can_lock());
+}
+
 // A stimulus log shorter than the video: every frame is tracked, the frames
 // past the log hold its last reading (and the tracker warns once).
 TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {

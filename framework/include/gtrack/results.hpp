@@ -33,6 +33,24 @@ class GTRACK_API ResultWriter {
   std::filesystem::path dir_;
 };
 
+// An exclusive lock on an output folder (flock on DIR/.gtrack_lock, which
+// holds the owner's pid), held while a run writes there: a second process
+// writing into the folder is refused with an InputError naming that pid.
+// Within one process it is taken again freely (track_sequence() and
+// two_pass() each take it; a caller that holds one across both keeps
+// another run out between them). It goes with the process, however it
+// ends. A file system without locks (some network mounts) runs without one.
+class GTRACK_API OutputLock {
+ public:
+  explicit OutputLock(const std::filesystem::path& out_dir);
+  ~OutputLock();
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+
+ private:
+  std::string key_;
+};
+
 // A JSON string literal of free text (a decoder's message, a file name):
 // quotes and backslashes escaped, control bytes and bytes that are not
 // UTF-8 (a Latin-1 file name) as \u00XX.

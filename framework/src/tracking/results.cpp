@@ -1,14 +1,22 @@
 // estimates.csv / estimates.jsonl rows and summary.json.
 #include "gtrack/results.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/text_file.hpp"
 #include "replace_file.hpp"
@@ -311,6 +319,66 @@ std::vector<int> resume_results(const fs::path& out_dir, int fingers, int last) 
   rewrite(csv, kept);
   rewrite(jsonl, jkept);
   return frames;
+}
+
+namespace {
+
+// The output folders this process holds locked: the lock file's descriptor
+// and how many OutputLocks share it.
+struct HeldLock {
+  int fd = -1;
+  int count = 0;
+};
+std::mutex g_held_mutex;
+std::map<std::string, HeldLock> g_held;
+
+}  // namespace
+
+OutputLock::OutputLock(const fs::path& out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw InputError(out_dir.string() + ": cannot create the output folder (" + ec.message() + ")");
+  const fs::path file = out_dir / ".gtrack_lock";
+  // flock() conflicts between two descriptors of one process too, so a
+  // folder this process holds is counted, not locked again.
+  const fs::path canonical = fs::weakly_canonical(file, ec);
+  key_ = ec ? fs::absolute(file).lexically_normal().string() : canonical.string();
+  const std::lock_guard<std::mutex> guard(g_held_mutex);
+  if (HeldLock& held = g_held[key_]; held.count > 0) {
+    ++held.count;
+    return;
+  }
+  const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    g_held.erase(key_);
+    throw InputError(file.string() + ": cannot open (" + std::strerror(errno) + ")");
+  }
+  const int locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0 ? 0 : errno;
+  if (locked == EWOULDBLOCK) {
+    char pid[32] = {};
+    const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
+    ::close(fd);
+    g_held.erase(key_);
+    const std::string who = n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : "";
+    throw InputError(out_dir.string() + ": another gtrack track run is writing there" + who +
+                     "; wait for it to end, or choose another --out");
+  }
+  if (locked != 0) {
+    // A file system without locks (some network mounts): nothing to say
+    // who else writes there, so the run goes on without one.
+    logger().debug("{}: cannot be locked ({})", file.string(), std::strerror(locked));
+  }
+  const std::string me = std::to_string(::getpid());
+  if (::ftruncate(fd, 0) == 0) (void)!::pwrite(fd, me.data(), me.size(), 0);
+  g_held[key_] = HeldLock{fd, 1};
+}
+
+OutputLock::~OutputLock() {
+  const std::lock_guard<std::mutex> guard(g_held_mutex);
+  const auto held = g_held.find(key_);
+  if (held == g_held.end() || --held->second.count > 0) return;
+  ::close(held->second.fd);
+  g_held.erase(held);
 }
 
 }  // namespace gtrack

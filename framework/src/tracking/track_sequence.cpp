@@ -1,6 +1,4 @@
 // `gtrack track` as a library call: source -> Tracker -> files.
-#include <fcntl.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -314,41 +312,6 @@ void check_resumed_folder(const TrackOptions& options, ImageSize size, double fp
                    " (images removed, added or renamed before it); cannot resume, the frames would be numbered "
                    "otherwise (put the images back as they were, or start a new run with another --out)");
 }
-
-// An exclusive lock on an output folder (flock on DIR/.gtrack_lock, which
-// holds the owner's pid), held while a run writes there.
-class OutputLock {
- public:
-  explicit OutputLock(const fs::path& dir) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw InputError(dir.string() + ": cannot create the output folder (" + ec.message() + ")");
-    const fs::path file = dir / ".gtrack_lock";
-    fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw InputError(file.string() + ": cannot open (" + std::strerror(errno) + ")");
-    const int locked = ::flock(fd_, LOCK_EX | LOCK_NB) == 0 ? 0 : errno;
-    if (locked != 0 && locked != EWOULDBLOCK) {
-      // A file system without locks (some network mounts): nothing to say
-      // who else writes there, so the run goes on without one.
-      logger().debug("{}: cannot be locked ({})", file.string(), std::strerror(locked));
-    } else if (locked == EWOULDBLOCK) {
-      char pid[32] = {};
-      const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
-      ::close(fd_);
-      const std::string who = n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : "";
-      throw InputError(dir.string() + ": another gtrack track run is writing there" + who +
-                       "; wait for it to end, or choose another --out");
-    }
-    const std::string me = std::to_string(::getpid());
-    if (::ftruncate(fd_, 0) == 0) (void)!::pwrite(fd_, me.data(), me.size(), 0);
-  }
-  ~OutputLock() { ::close(fd_); }
-  OutputLock(const OutputLock&) = delete;
-  OutputLock& operator=(const OutputLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
 
 }  // namespace
 

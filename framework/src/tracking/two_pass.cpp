@@ -180,6 +180,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   }
   TwoPassSummary summary;
   if (forward.empty()) return summary;
+  const OutputLock lock(options.out_dir);
 
   // The backward tracker has a Setup of its own: the sensor and the gripper
   // are shared, the stimulus is replayed frame by frame.
