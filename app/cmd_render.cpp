@@ -60,11 +60,8 @@ int run_render(const gtrack::cli::CommonOptions& common, const po::variables_map
   ro.scale = vm["scale"].as<double>();
   if (!(ro.scale > 0 && ro.scale <= 1)) throw gtrack::cli::UsageError("--scale must be in (0, 1]");
   // As [render] scale: a mask a few pixels across shows no shape.
-  const gtrack::ImageSize full = setup.sensor->image_size();
-  if (std::min(std::lround(ro.scale * full.width), std::lround(ro.scale * full.height)) < 8) {
-    throw gtrack::cli::UsageError(fmt::format("--scale {:g}", ro.scale) + " renders the " + std::to_string(full.width) +
-                                  "x" + std::to_string(full.height) +
-                                  " image with fewer than 8 pixels on a side; expected a larger scale");
+  if (const std::string small = gtrack::render_scale_problem(setup.sensor->image_size(), ro.scale); !small.empty()) {
+    throw gtrack::cli::UsageError(fmt::format("--scale {:g} ", ro.scale) + small);
   }
   auto renderer = gtrack::make_renderer(ro);
   renderer->set_model(model);

@@ -7,6 +7,19 @@
 
 namespace gtrack {
 
+std::vector<LinkShape> links_from_config(const ConfigTable& t, const std::vector<double>& lengths,
+                                         const std::vector<double>& widths) {
+  std::vector<LinkShape> links;
+  for (size_t j = 0; j < lengths.size() && j + 1 < widths.size(); ++j) {
+    if (widths[j] <= 0 && widths[j + 1] <= 0) {
+      t.fail("link_widths_mm", "link " + std::to_string(j + 1) + " is 0 wide at both ends; a link needs a width at "
+                                                                     "one end at least");
+    }
+    links.push_back({lengths[j], widths[j], widths[j + 1]});
+  }
+  return links;
+}
+
 GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDefaults d) {
   RadialGripperSpec spec = d.spec;
   const Range size{0.0, ArticulatedModel::kMaxSizeMm, true, false};
@@ -25,14 +38,7 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
   }
   std::vector<double> widths =
       t.numbers_or("link_widths_mm", d.widths_mm, lengths.size() + 1, Range::closed(0, ArticulatedModel::kMaxSizeMm));
-  spec.links.clear();
-  for (size_t j = 0; j < lengths.size(); ++j) {
-    if (widths[j] <= 0 && widths[j + 1] <= 0) {
-      t.fail("link_widths_mm", "link " + std::to_string(j + 1) + " is 0 wide at both ends; a link needs a width at "
-                                                                     "one end at least");
-    }
-    spec.links.push_back({lengths[j], widths[j], widths[j + 1]});
-  }
+  spec.links = links_from_config(t, lengths, widths);
 
   GripperGeometry g = make_radial_gripper(spec);
   g.joint_min_deg = t.number_or("joint_min_deg", d.joint_min_deg, Range::closed(-180, 180));

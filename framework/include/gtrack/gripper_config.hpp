@@ -26,6 +26,12 @@ struct RadialGripperDefaults {
   double folded_deg = 60;
 };
 
+// The links of a finger from link_lengths_mm and link_widths_mm (the width
+// at each hinge and at the tip, one more than the lengths): a link 0 wide
+// at both ends fails on link_widths_mm, naming the link.
+GTRACK_API std::vector<LinkShape> links_from_config(const ConfigTable& table, const std::vector<double>& lengths,
+                                                    const std::vector<double>& widths);
+
 GTRACK_API GripperGeometry radial_gripper_from_config(const ConfigTable& table, RadialGripperDefaults defaults);
 
 // A radial gripper plugin is its defaults: RadialGripper<my_defaults> reads

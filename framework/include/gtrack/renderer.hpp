@@ -85,6 +85,12 @@ GTRACK_API bool hardware_gpu_available();
 
 // The projection scaled to render resolution.
 GTRACK_API Projection scaled_projection(const Projection& projection, double scale);
+
+// Why `scale` is too small for an image of `size` ("" when it is not): a
+// render with fewer than 8 pixels on a side has no shape left to compare.
+// Said as "renders the WxH image at wxh pixels; expected a scale that keeps
+// at least 8 pixels on each side".
+GTRACK_API std::string render_scale_problem(ImageSize size, double scale);
 // The same projection on a canvas grown by margin_x and margin_y pixels on
 // every side: pixel (u, v) becomes (u + margin_x, v + margin_y), so what lies
 // beyond the image's borders (up to the margin) is rendered too.

@@ -120,6 +120,14 @@ void clip_triangle(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const E
 
 }  // namespace render
 
+std::string render_scale_problem(ImageSize size, double scale) {
+  const long w = std::lround(scale * size.width), h = std::lround(scale * size.height);
+  if (std::min(w, h) >= 8) return "";
+  return "renders the " + std::to_string(size.width) + "x" + std::to_string(size.height) + " image at " +
+         std::to_string(std::max(1L, w)) + "x" + std::to_string(std::max(1L, h)) +
+         " pixels; expected a scale that keeps at least 8 pixels on each side";
+}
+
 Projection scaled_projection(const Projection& projection, double scale) {
   if (!(scale > 0)) throw Error("render scale must be positive, got " + std::to_string(scale));
   Projection p = projection;

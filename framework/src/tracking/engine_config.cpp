@@ -95,14 +95,7 @@ RenderOptions read_render(const ConfigTable& t, const Sensor& sensor) {
   RenderOptions r;
   r.backend = t.choice_or("backend", r.backend, {"auto", "gl", "cpu"});
   r.scale = t.number_or("scale", r.scale, {0.0, 1.0, true, false});
-  // A render a few pixels across has no shape left to compare.
-  const ImageSize size = sensor.image_size();
-  const long w = std::lround(r.scale * size.width), h = std::lround(r.scale * size.height);
-  if (std::min(w, h) < 8) {
-    t.fail("scale", "renders the " + std::to_string(size.width) + "x" + std::to_string(size.height) + " image at " +
-                        std::to_string(std::max(1L, w)) + "x" + std::to_string(std::max(1L, h)) +
-                        " pixels; expected a scale that keeps at least 8 pixels on each side");
-  }
+  if (const std::string small = render_scale_problem(sensor.image_size(), r.scale); !small.empty()) t.fail("scale", small);
   r.threads = static_cast<int>(t.integer_or("threads", r.threads, Range::closed(0, 1024)));
   r.egl_device = t.string_or("egl_device", r.egl_device);
   // Whether the device exists is the gl backend's to say; the form is known here.

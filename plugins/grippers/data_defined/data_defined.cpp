@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <gtrack/error.hpp>
+#include <gtrack/gripper_config.hpp>
 #include <cstdio>
 #include <gtrack/plugin.hpp>
 
@@ -32,12 +33,7 @@ std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
   const auto lengths = t.numbers("link_lengths_mm", std::nullopt, kLength);
   if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
   const auto widths = t.numbers("link_widths_mm", lengths.size() + 1, Range::closed(0, kMaxMm));
-  std::vector<gtrack::LinkShape> links;
-  for (size_t j = 0; j < lengths.size(); ++j) {
-    if (widths[j] <= 0 && widths[j + 1] <= 0) t.fail("link_widths_mm", "a link needs a width at one end at least");
-    links.push_back({lengths[j], widths[j], widths[j + 1]});
-  }
-  return links;
+  return gtrack::links_from_config(t, lengths, widths);
 }
 
 gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
