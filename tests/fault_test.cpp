@@ -473,6 +473,40 @@ TEST(Fault, AnOutputLockIsTakenAgainWithinAProcessAndHeldUntilTheLastRelease) {
   EXPECT_TRUE(others_can_lock());
 }
 
+// The stimulus log's rows are checked before any frame is tracked by an
+// instance of the plugin fed each row at its frame's time (it had been fed
+// the row's number as seconds, so a plugin's rate limit let a spike
+// through and stopped the run part way, naming no file).
+TEST(Fault, AStimulusLogRowThePluginRefusesAtItsTimeStopsTheRunBeforeAnyFrame) {
+  const fs::path dir = fresh_dir("rate_limited");
+  std::string config = kConfig;
+  const size_t at = config.find("[stimulus]");
+  const size_t end = config.find("\n[", at + 1);
+  ASSERT_NE(at, std::string::npos);
+  config.replace(at, end - at, "[stimulus]\nplugin = \"fixture_wrong_stimulus\"\nwrong = \"max_rate\"");
+  auto root = gtrack::ConfigTable::parse(config, "fault.toml");
+  gtrack::SetupOptions so;
+  so.plugin_paths = {GTRACK_TEST_FIXTURE_DIR};
+  TrackRun r{gtrack::load_setup(root, so), {}};
+  r.config = gtrack::engine_config(r.setup);
+  gtrack::TrackOptions o = folder_run(dir, 3);
+  // 30 frames/s: 0.5 a frame is 15 a second; 3 in one frame is 90 (taken),
+  // 5 is 150 (refused). As rows one second apart, both were taken.
+  std::ofstream(dir / "ok.csv") << "frame,value\n0,20\n1,20.5\n2,23.5\n";
+  std::ofstream(dir / "spike.csv") << "frame,value\n0,20\n1,20.5\n2,25.5\n";
+  o.stimulus_csv = dir / "ok.csv";
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 3);
+  o.stimulus_csv = dir / "spike.csv";
+  o.out_dir = dir / "spiked";
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    ADD_FAILURE() << "a reading the plugin refuses was tracked";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind((dir / "spike.csv").string() + ":4: a change of 150", 0), 0u) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(o.out_dir / "estimates.csv"));
+}
+
 // A stimulus log shorter than the video: every frame is tracked, the frames
 // past the log hold its last reading (and the tracker warns once).
 TEST(Fault, StimulusLogEndingEarlyHoldsTheLastReading) {

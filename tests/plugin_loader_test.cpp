@@ -45,6 +45,36 @@ TEST(PluginLoader, DiscoversTheBuiltInPlugins) {
   for (const auto& r : records) EXPECT_TRUE(fs::exists(r.file)) << r.file;
 }
 
+// A stimulus plugin's results are checked as the tracker takes them: a NaN
+// penalty had made frames "ok" with no cost, a range upside down had
+// clamped the joints to nothing; each is now a PluginError naming the
+// plugin, the call and what was expected.
+TEST(PluginLoader, AStimulusPluginsUnusableResultsAreRefusedNamingIt) {
+  gtrack::PluginLoader loader({kFixtures});
+  const auto made = [&](const std::string& wrong) {
+    auto root = gtrack::ConfigTable::parse(
+        "[stimulus]\nplugin = \"fixture_wrong_stimulus\"\nwrong = \"" + wrong + "\"\n", "t.toml");
+    return loader.make_stimulus(root.table("stimulus"));
+  };
+  const std::vector<double> joints{10, 20};
+  const std::string plugin = "stimulus plugin 'fixture_wrong_stimulus': ";
+  EXPECT_EQ(plugin_error([&] { made("nan_penalty")->penalty(joints); }),
+            plugin + "penalty() returned nan; expected a finite number, 0 or more");
+  EXPECT_EQ(plugin_error([&] { made("range_upside_down")->state(); }),
+            plugin + "state() returned a feasible joint range of 60 to 10 deg; expected feasible_min_deg <= "
+                     "feasible_max_deg, neither nan");
+  EXPECT_EQ(plugin_error([&] { made("fold_fraction")->fold_fraction(); }),
+            plugin + "fold_fraction() returned 1.5; expected a number in [0, 1]");
+  const auto right = made("nothing");
+  EXPECT_EQ(plugin_error([&] {
+              right->update(3.5, 0.1);
+              EXPECT_EQ(right->state().value, 3.5);
+              EXPECT_EQ(right->penalty(joints), 0.0);
+              EXPECT_EQ(right->fold_fraction(), 0.5);
+            }),
+            "");
+}
+
 TEST(PluginLoader, NotFoundListsPathsAndAvailablePlugins) {
   gtrack::PluginLoader loader({"/nonexistent/dir"});
   std::string e = plugin_error([&] { loader.make_sensor(table("pinhole_microscop")); });

@@ -64,19 +64,26 @@ TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
 // A check of each reading (the tracker's: an instance of the stimulus
 // plugin) that throws is an error naming the file and the row's line.
 TEST(StimulusLog, AReadingTheCheckRefusesNamesItsLine) {
-  std::vector<double> seen;
-  const auto check = [&](double v) {
+  std::vector<double> seen, at;
+  std::vector<StimulusLog::Key> keys;
+  const auto check = [&](double v, StimulusLog::Key key, double k) {
     seen.push_back(v);
+    keys.push_back(key);
+    at.push_back(k);
     if (v > 150) throw std::invalid_argument("a reading of " + std::to_string(static_cast<int>(v)) + ", too hot");
   };
-  EXPECT_NO_THROW(StimulusLog::parse("frame,value\n0,20\n# note\n1,21\n", "log.csv", check));
+  EXPECT_NO_THROW(StimulusLog::parse("frame,value\n0,20\n# note\n3,21\n", "log.csv", check));
   EXPECT_EQ(seen, (std::vector<double>{20, 21}));
+  EXPECT_EQ(at, (std::vector<double>{0, 3}));
+  EXPECT_EQ(keys, (std::vector<StimulusLog::Key>{StimulusLog::Key::Frame, StimulusLog::Key::Frame}));
   try {
     StimulusLog::parse("time_s,value\n0,20\n\n0.5,295.15\n", "log.csv", check);
     ADD_FAILURE() << "a refused reading was taken";
   } catch (const gtrack::InputError& e) {
     EXPECT_STREQ(e.what(), "log.csv:4: a reading of 295, too hot");
   }
+  EXPECT_EQ(at.back(), 0.5);
+  EXPECT_EQ(keys.back(), StimulusLog::Key::Time);
 }
 
 TEST(StimulusLog, MissingFileIsAnInputError) {

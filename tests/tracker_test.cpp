@@ -345,6 +345,78 @@ TEST(Tracker, NothingDetectedIsLostNotAnError) {
   EXPECT_EQ(e.hypothesis, pose(0.3, -0.2, 20, 5));  // held
 }
 
+// A frame whose search ends above [tracker] lost_dice reports the estimate
+// the track holds, not the result it did not take.
+TEST(Tracker, AFrameLostByItsCostReportsTheHeldEstimate) {
+  auto setup = make_setup("[tracker]\nlost_dice = 0.0001\n");
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  const Eigen::VectorXd held = pose(0.3, -0.2, 20, 5);
+  tracker.set_estimate(held);
+  const auto e = tracker.process(scene(setup, pose(0.35, -0.15, 24, 9), 2), 0, 0.0, std::nullopt);
+  ASSERT_EQ(e.status, gtrack::TrackStatus::Lost);
+  EXPECT_GT(e.observed_pixels, 0u);
+  EXPECT_EQ(e.hypothesis, held);
+  EXPECT_EQ(*tracker.last_estimate(), held);
+  EXPECT_DOUBLE_EQ(e.terms.total, tracker.score(held).total);
+}
+
+// process() refuses what it cannot track with an InputError and, for a
+// frame of the wrong size, leaves the tracker as it was: a state saved
+// after the refusal does not claim the frame.
+TEST(Tracker, ARefusedFrameTimeOrReadingLeavesTheTrackerAsItWas) {
+  auto setup = make_setup();
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  const cv::Mat frame = scene(setup, pose(0.3, -0.2, 20, 5), 1);
+  tracker.process(frame, 0, 0.0, 24.0);
+  const auto before = tracker.state();
+  EXPECT_THROW(tracker.process(cv::Mat(100, 100, CV_8UC3, cv::Scalar(0, 0, 0)), 1, 0.033, 24.0), gtrack::InputError);
+  EXPECT_EQ(tracker.state().frame, before.frame);
+  EXPECT_EQ(*tracker.state().last, *before.last);
+  const auto message = [&](double time_s, std::optional<double> reading) {
+    try {
+      tracker.process(frame, 1, time_s, reading);
+    } catch (const gtrack::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(std::nan(""), 24.0), "frame 1: its time is nan; expected a finite number of seconds");
+  EXPECT_EQ(message(0.033, std::numeric_limits<double>::infinity()),
+            "frame 1: its stimulus reading is inf; expected a finite number");
+  EXPECT_EQ(tracker.state().frame, before.frame);
+  // A reading the plugin refuses names the frame and the reading.
+  EXPECT_EQ(message(0.033, 295.0).rfind("frame 1 (t = 0.033 s): the stimulus plugin refused the reading 295: ", 0), 0u)
+      << message(0.033, 295.0);
+  EXPECT_THROW(tracker.set_estimate(Eigen::VectorXd::Constant(12, std::nan(""))), gtrack::Error);
+}
+
+// reset(): the next frame starts like the first, the stimulus plugin's state
+// included (a heated gripper's plugin had kept its fold).
+TEST(Tracker, ResetStartsTheStimulusAgain) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  const cv::Mat frame = scene(setup, pose(0.3, -0.2, 20, 5), 1);
+  gtrack::Tracker fresh(make_setup(), config);
+  const auto first = fresh.process(frame, 0, 0.0, 22.0);
+  gtrack::Tracker used(setup, config);
+  for (int i = 0; i < 4; ++i) used.process(frame, i, i / 30.0, 22.0 + 5 * i);  // heated past its fold
+  used.reset();
+  EXPECT_EQ(used.process(frame, 0, 0.0, 22.0).hypothesis, first.hypothesis);
+}
+
+// After restore() the tracker holds no observation: score() says so.
+TEST(Tracker, ScoreAfterARestoreNeedsAFrame) {
+  auto setup = make_setup();
+  const auto config = gtrack::engine_config(setup);
+  gtrack::Tracker a(setup, config);
+  a.process(scene(setup, pose(0.3, -0.2, 20, 5), 1), 0, 0.0, 24.0);
+  auto other = make_setup();
+  gtrack::Tracker b(other, config);
+  b.restore(a.state());
+  EXPECT_THROW(b.score(pose(0.3, -0.2, 20, 5)), gtrack::Error);
+  EXPECT_NO_THROW(a.score(pose(0.3, -0.2, 20, 5)));
+}
+
 // The tracker searches in the sensor's own frame: a probe turned in the
 // world (looking down world -z, its slice the world's x-z plane) that sees
 // the images an upright probe sees gives the upright probe's estimates,

@@ -13,6 +13,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "checked_stimulus.hpp"
 
 namespace gtrack {
 
@@ -341,7 +342,9 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
 
 std::shared_ptr<Sensor> PluginLoader::make_sensor(const ConfigTable& t) const { return make<Sensor>(t); }
 std::shared_ptr<Gripper> PluginLoader::make_gripper(const ConfigTable& t) const { return make<Gripper>(t); }
-std::shared_ptr<Stimulus> PluginLoader::make_stimulus(const ConfigTable& t) const { return make<Stimulus>(t); }
+std::shared_ptr<Stimulus> PluginLoader::make_stimulus(const ConfigTable& t) const {
+  return std::make_shared<detail::CheckedStimulus>(make<Stimulus>(t), t.string("plugin"));
+}
 
 template GTRACK_API std::shared_ptr<Sensor> PluginLoader::make_from_file<Sensor>(const fs::path&, const std::string&,
                                                                                  const ConfigTable&) const;

@@ -53,6 +53,15 @@ struct FrameRange {
 // Parses "A:B", "A:", ":B" or "A" (A inclusive, B exclusive).
 GTRACK_API FrameRange parse_frame_range(const std::string& text);
 
+// A frame as the tracker takes it (8-bit BGR), from what a camera or a
+// file gives: grey, grey and alpha, BGR or BGRA, 8 or 16 bits per sample;
+// 16-bit samples are scaled by 255 / (2^image_bits - 1), image_bits being
+// how many low bits the camera fills ([tracker] image_bits; 16 for data in
+// the high bits). What every FrameSource does to its frames, for frames
+// grabbed by an application and given to Tracker::process. InputError
+// (naming `name`) for other depths or channel counts.
+GTRACK_API cv::Mat to_tracker_image(const cv::Mat& image, int image_bits = 16, const std::string& name = "frame");
+
 class GTRACK_API FrameSource {
  public:
   virtual ~FrameSource();

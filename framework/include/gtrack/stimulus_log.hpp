@@ -8,9 +8,11 @@
 // after the last row is outside the log: value_at() returns nullopt and the
 // tracker warns once and holds the nearest reading.
 //
-// A ReadingCheck sees each row's reading as it is read and throws for one
-// it refuses (a stimulus plugin's update() given a temperature in kelvin);
-// the error is then "file:line: <its message>".
+// A ReadingCheck sees each row's reading as it is read, with the row's key
+// (its frame index or time_s, as the header says), and throws for one it
+// refuses (a stimulus plugin's update() given a temperature in kelvin, or
+// a change too fast for its rate limit); the error is then
+// "file:line: <its message>".
 #pragma once
 
 #include <filesystem>
@@ -28,7 +30,7 @@ class GTRACK_API StimulusLog {
  public:
   enum class Key { Frame, Time };
 
-  using ReadingCheck = std::function<void(double value)>;
+  using ReadingCheck = std::function<void(double value, Key key, double at)>;
 
   static StimulusLog load(const std::filesystem::path& file, ReadingCheck check = {});
   static StimulusLog parse(const std::string& text, const std::string& source = "<string>",

@@ -104,7 +104,12 @@ struct Estimate {
 
 // One Tracker follows one sequence. It keeps the Setup's plugin instances
 // (shared pointers): process() feeds the Setup's Stimulus, so two trackers
-// running at once need a Setup each.
+// running at once need a Setup each (nothing detects two on one Setup).
+//
+// Threads: a Tracker is used by one thread at a time. With the gl backend
+// its OpenGL context is made current on the thread that constructs it, so
+// construct it on the thread that will call process() (a camera thread,
+// say); from another, process() throws "eglMakeCurrent failed".
 //
 // The configurations it takes and gives are in the world. It searches in
 // the sensor's own frame (SensorFrame in sensor.hpp), as its config's space
@@ -119,13 +124,24 @@ class GTRACK_API Tracker {
   ~Tracker();
   Tracker(const Tracker&) = delete;
   Tracker& operator=(const Tracker&) = delete;
+  Tracker(Tracker&&) noexcept;  // the moved-from tracker can only be destroyed or assigned
+  Tracker& operator=(Tracker&&) noexcept;
 
-  // Tracks one frame (BGR at the sensor's image size). `stimulus` is the
-  // reading for this frame; nullopt = no reading (the configured default is
-  // used if any, else S and the bias are off).
+  // Tracks one frame (BGR at the sensor's image size; a camera's 16-bit or
+  // grey frames through to_tracker_image() first). `index` numbers the
+  // frame and seeds its random draws (frames numbered alike give the same
+  // estimates); `time_s` is its time in seconds, finite and, for the
+  // stimulus plugin, increasing. `stimulus` is the reading for this frame;
+  // nullopt = no reading (the configured default is used if any, else S and
+  // the bias are off). InputError for a frame of another size or type, a
+  // time or reading that is not finite, or a reading the stimulus plugin
+  // refuses (naming the frame); a frame refused for its size or type leaves
+  // the tracker as it was.
   Estimate process(const cv::Mat& frame, int index, double time_s, std::optional<double> stimulus);
 
-  // Forget the history: the next frame starts like the first.
+  // Forget the history: the next frame starts like the first. The stimulus
+  // plugin is made anew from the config's [stimulus] table when the Setup
+  // has its loader (load_setup's do); otherwise it keeps its state.
   void reset();
   // The history, in the frame the tracker searches in (the class comment).
   TrackerState state() const;
@@ -139,11 +155,13 @@ class GTRACK_API Tracker {
   void set_estimate(const Eigen::VectorXd& hypothesis);
   std::optional<Eigen::VectorXd> last_estimate() const;
 
-  // The observation of the last processed frame (render size, 0/255).
+  // The observation of the last processed frame (render size, 0/255); the
+  // next process() overwrites it, so copy what is to be kept.
   const Observation& last_observation() const;
   // A configuration scored on the last processed frame as its estimate was:
   // the same observation, occlusion allowance, temporal prediction and
-  // stimulus state. Throws before the first frame.
+  // stimulus state. Throws before this tracker has processed a frame (a
+  // restored state holds no observation).
   CostTerms score(const Eigen::VectorXd& hypothesis);
   // The same, but with the occlusion allowance a track whose previous
   // estimate was `previous` would have had on this frame (the model's whole

@@ -37,7 +37,7 @@ void FrameSource::set_image_bits(int bits) {
   image_bits_ = bits;
 }
 
-cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
+cv::Mat to_tracker_image(const cv::Mat& image, int image_bits, const std::string& name) {
   if (image.depth() != CV_8U && image.depth() != CV_16U) {
     const char* depth = image.depth() == CV_32F   ? "32-bit float"
                         : image.depth() == CV_64F ? "64-bit float"
@@ -47,38 +47,47 @@ cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
     throw InputError(name + ": a " + std::string(depth) +
                      " image; expected 8 or 16 bits per sample (convert it to 8 or 16 bits first)");
   }
+  if (image.channels() != 1 && image.channels() != 2 && image.channels() != 3 && image.channels() != 4) {
+    throw InputError(name + ": an image of " + std::to_string(image.channels()) +
+                     " channels; expected grey, grey and alpha, BGR or BGRA");
+  }
+  if (image_bits < 1 || image_bits > 16) {
+    throw InputError(name + ": image_bits is " + std::to_string(image_bits) + "; expected 1 to 16");
+  }
   cv::Mat out = image;
   if (out.channels() == 2) {  // grey and alpha
     cv::extractChannel(out, out, 0);
   } else if (out.channels() == 4) {
     cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
   }
-  if (out.depth() == CV_16U) {
-    const double top = std::ldexp(1.0, image_bits_) - 1.0;
-    if (!checked_bits_ && !quiet_) {
-      // The first 16-bit image: values that stay under a sixteenth of the
-      // range are most likely a camera of fewer bits than said (12-bit
-      // data in 16-bit files).
-      checked_bits_ = true;
-      double max = 0;
-      cv::minMaxLoc(out.reshape(1), nullptr, &max);
-      if (max > 0 && max < (top + 1) / 16) {
-        logger().warn("{}: a 16-bit image whose values reach only {} of {:.0f}, so it is dark at 8 bits; if the "
-                      "camera gives fewer bits, say so with [tracker] image_bits (now {})",
-                      name, max, top, image_bits_);
-      } else if (max > top) {
-        // Fewer bits said than the files hold: a camera that puts its 12
-        // bits in the high bits of each sample needs no image_bits at all.
-        logger().warn("{}: a 16-bit image with values up to {}, above the {:.0f} of [tracker] image_bits = {}, "
-                      "which saturate; image_bits is for data in the low bits (data in the high bits needs the "
-                      "default, 16)",
-                      name, max, top, image_bits_);
-      }
-    }
-    out.convertTo(out, CV_8U, 255.0 / top);
-  }
+  if (out.depth() == CV_16U) out.convertTo(out, CV_8U, 255.0 / (std::ldexp(1.0, image_bits) - 1.0));
   if (out.channels() == 1) cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
   return out;
+}
+
+cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
+  if (image.depth() == CV_16U && !checked_bits_ && !quiet_) {
+    // The first 16-bit image: values that stay under a sixteenth of the
+    // range are most likely a camera of fewer bits than said (12-bit data
+    // in 16-bit files).
+    checked_bits_ = true;
+    const double top = std::ldexp(1.0, image_bits_) - 1.0;
+    double max = 0;
+    cv::minMaxLoc(image.reshape(1), nullptr, &max);
+    if (max > 0 && max < (top + 1) / 16) {
+      logger().warn("{}: a 16-bit image whose values reach only {} of {:.0f}, so it is dark at 8 bits; if the "
+                    "camera gives fewer bits, say so with [tracker] image_bits (now {})",
+                    name, max, top, image_bits_);
+    } else if (max > top) {
+      // Fewer bits said than the files hold: a camera that puts its 12
+      // bits in the high bits of each sample needs no image_bits at all.
+      logger().warn("{}: a 16-bit image with values up to {}, above the {:.0f} of [tracker] image_bits = {}, "
+                    "which saturate; image_bits is for data in the low bits (data in the high bits needs the "
+                    "default, 16)",
+                    name, max, top, image_bits_);
+    }
+  }
+  return to_tracker_image(image, image_bits_, name);
 }
 
 namespace {

@@ -106,7 +106,7 @@ void StimulusLog::take_line(std::string line) {
   }
   if (check_) {
     try {
-      check_(v);
+      check_(v, key_, k);
     } catch (const std::exception& e) {
       throw InputError(where + e.what());
     }

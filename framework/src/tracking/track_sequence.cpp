@@ -351,27 +351,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     for (const auto& row : table.rows) reference_rows[row.frame] = row.h;
   }
   int restarts_used = 0, references_used = 0;
-  // The readings are checked before a frame is tracked, by an instance of
-  // the stimulus plugin of its own: the configured default, and each log row
-  // as it is read, so that one the plugin refuses (a temperature in kelvin)
-  // is an error naming its key or its line.
-  std::shared_ptr<Stimulus> probe;
-  if (setup.loader && setup.stimulus && (options.stimulus_csv || config.tracker.default_stimulus)) {
-    probe = setup.loader->make_stimulus(setup.root.table("stimulus"));
-  }
-  if (probe && config.tracker.default_stimulus) {
-    try {
-      probe->update(*config.tracker.default_stimulus, 0);
-    } catch (const std::exception& e) {
-      throw ConfigError(setup.root.table("tracker").where("default_stimulus") + ": " + e.what());
-    }
-  }
-  if (options.stimulus_csv) {
-    StimulusLog::ReadingCheck check;
-    if (probe) check = [probe, row = 1](double value) mutable { probe->update(value, row++); };
-    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
-                                  : StimulusLog::load(*options.stimulus_csv, std::move(check));
-  }
   // Resuming: the saved state says which frame was done last; the source
   // starts at the next frame of the range.
   const fs::path state_file = options.out_dir / "tracker_state.txt";
@@ -441,6 +420,30 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     logger().warn("{}: the video says {:g} frames/s, [tracker] fps = {:g} is taken; its frame times, a time_s "
                   "stimulus log and the material's response run on {:g} (remove fps to take the video's)",
                   options.input, source->fps(), config.tracker.fps, config.tracker.fps);
+  }
+  // The readings are checked before a frame is tracked, each by an instance
+  // of the stimulus plugin of its own: the configured default, and each log
+  // row as it is read, at its frame's time, so that one the plugin refuses
+  // (a temperature in kelvin, a change faster than it allows) is an error
+  // naming its key or its line.
+  const bool can_probe = setup.loader && setup.stimulus;
+  const auto make_probe = [&] { return setup.loader->make_stimulus(setup.root.table("stimulus")); };
+  if (can_probe && config.tracker.default_stimulus) {
+    try {
+      make_probe()->update(*config.tracker.default_stimulus, 0);
+    } catch (const std::exception& e) {
+      throw ConfigError(setup.root.table("tracker").where("default_stimulus") + ": " + e.what());
+    }
+  }
+  if (options.stimulus_csv) {
+    StimulusLog::ReadingCheck check;
+    if (can_probe) {
+      check = [probe = make_probe(), fps](double value, StimulusLog::Key key, double at) {
+        probe->update(value, key == StimulusLog::Key::Time ? at : at / fps);
+      };
+    }
+    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
+                                  : StimulusLog::load(*options.stimulus_csv, std::move(check));
   }
   const int expected = expected_frames(*source, range);
   const std::string described = source->description();
@@ -720,7 +723,14 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     } catch (const std::exception&) {
       // The error that stopped the run is the one to report.
     }
-    if (!kept.empty() && dynamic_cast<const InputError*>(&e)) throw InputError(e.what() + kept);
+    // gtrack's own errors say what was kept, as the kind they are.
+    if (!kept.empty() && dynamic_cast<const Error*>(&e)) {
+      const std::string what = e.what() + kept;
+      if (dynamic_cast<const InputError*>(&e)) throw InputError(what);
+      if (dynamic_cast<const PluginError*>(&e)) throw PluginError(what);
+      if (dynamic_cast<const ConfigError*>(&e)) throw ConfigError(what);
+      throw Error(what);
+    }
     throw;
   }
   // A table of other frames (renumbered, another sequence's) changes nothing: said.

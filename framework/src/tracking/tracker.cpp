@@ -74,6 +74,7 @@ struct Tracker::Impl {
   // are +-1e9) says nothing about the fold.
   static constexpr double kUnboundedJointRangeDeg = 1e6;
   bool started = false;  // a frame has been processed since construction or reset
+  bool observed = false;  // `observation` is of a frame this instance processed (not restored)
   int last_frame = -1;   // the last frame processed
   int lost = 0;          // consecutive lost frames
   Observation observation;
@@ -169,15 +170,16 @@ struct Tracker::Impl {
     e.frame = index;
     e.time_s = time_s;
     std::mt19937_64 rng(frame_seed(config.pso.seed, index));
-    last_frame = index;
-
-    reading = feed_stimulus(reading, time_s);
-    const bool stimulus_on = reading.has_value() && setup.stimulus != nullptr;
-    e.stimulus = reading;
-    cost->set_stimulus(stimulus_on ? setup.stimulus.get() : nullptr);
+    if (!std::isfinite(time_s)) {
+      throw InputError(fmt::format("frame {}: its time is {}; expected a finite number of seconds", index, time_s));
+    }
+    if (reading && !std::isfinite(*reading)) {
+      throw InputError(fmt::format("frame {}: its stimulus reading is {}; expected a finite number", index, *reading));
+    }
 
     // Observation: around the previous estimate while it is trusted, the
-    // whole image when there is none or it has been lost for too long.
+    // whole image when there is none or it has been lost for too long. A
+    // frame refused here (its size or type) leaves the tracker as it was.
     const cv::Mat frame = setup.sensor->rectify(input);
     const bool searching = !last || lost >= config.tracker.reinit_after_lost;
     std::uint64_t previous_area = 0;  // |P| of the previous estimate, render pixels
@@ -190,6 +192,12 @@ struct Tracker::Impl {
     } else {
       observation = segmenter->observe(frame, nullptr);
     }
+    last_frame = index;
+
+    reading = feed_stimulus(reading, time_s, index);
+    const bool stimulus_on = reading.has_value() && setup.stimulus != nullptr;
+    e.stimulus = stimulus_on ? reading : std::nullopt;
+    cost->set_stimulus(stimulus_on ? setup.stimulus.get() : nullptr);
     // Occlusion handling (docs/tracker.md, "Partial occlusion"): the
     // constant-velocity prediction for the temporal term, and, when O is
     // smaller than the model at the previous estimate, the weight of rendered
@@ -390,10 +398,15 @@ struct Tracker::Impl {
       e.observed_pixels = observation.count;
       e.terms = reported_terms;
       if (terms.dice > config.tracker.lost_dice) {
+        // The search's result is not taken: the frame reports the estimate
+        // the track holds, scored on this frame.
         ++lost;
         e.status = TrackStatus::Lost;
         if (!last) last = best;
         forget_motion();
+        e.hypothesis = *last;
+        e.unseen_fingers.clear();
+        e.terms = cost->evaluate_one(*last);
       } else {
         lost = 0;
         // A velocity needs two estimates of one continuous track: not across
@@ -416,6 +429,7 @@ struct Tracker::Impl {
       }
     }
     started = true;
+    observed = true;
     e.times.pso_ms = ms_since(t1);
     e.ms = ms_since(t0);
     return e;
@@ -471,9 +485,19 @@ struct Tracker::Impl {
 
   // The reading in force for a frame (the configured default when there is
   // none), fed to the stimulus plugin.
-  std::optional<double> feed_stimulus(std::optional<double> reading, double time_s) {
+  // A reading the plugin refuses is an InputError naming the frame (`index`;
+  // -1 for a replayed one) and the reading.
+  std::optional<double> feed_stimulus(std::optional<double> reading, double time_s, int index) {
     if (!reading && config.tracker.default_stimulus) reading = config.tracker.default_stimulus;
-    if (reading && setup.stimulus) setup.stimulus->update(*reading, time_s);
+    if (!reading || !setup.stimulus) return reading;
+    try {
+      setup.stimulus->update(*reading, time_s);
+    } catch (const std::exception& refused) {
+      const std::string when = index >= 0 ? fmt::format("frame {} (t = {:.3f} s)", index, time_s)
+                                          : fmt::format("the replayed reading at t = {:.3f} s", time_s);
+      throw InputError(fmt::format("{}: the stimulus plugin refused the reading {:g}: {}", when, *reading,
+                                   refused.what()));
+    }
     return reading;
   }
 
@@ -641,11 +665,20 @@ Estimate Tracker::process(const cv::Mat& frame, int index, double time_s, std::o
   return e;
 }
 
+Tracker::Tracker(Tracker&&) noexcept = default;
+Tracker& Tracker::operator=(Tracker&&) noexcept = default;
+
 void Tracker::reset() {
+  // The stimulus plugin starts again too: made anew from its table where
+  // the setup has a loader (its state has no reset of its own).
+  if (impl_->setup.stimulus && impl_->setup.loader && impl_->setup.root.has("stimulus")) {
+    impl_->setup.stimulus = impl_->setup.loader->make_stimulus(impl_->setup.root.table("stimulus"));
+  }
   impl_->last.reset();
   impl_->forget_motion();
   impl_->reference_area = 0;
   impl_->started = false;
+  impl_->observed = false;
   impl_->last_frame = -1;
   impl_->lost = 0;
 }
@@ -674,6 +707,10 @@ void Tracker::restore(const TrackerState& s) {
   if (s.found_step && s.found_step->size() != 2) {
     throw Error("holds a found step of " + std::to_string(s.found_step->size()) + " values, expected 2 (x, y)");
   }
+  for (const auto* h : {&s.last, &s.before_last}) {
+    if (*h && !(*h)->allFinite()) throw Error("holds a configuration that is not finite (nan or inf)");
+  }
+  if (s.found_step && !s.found_step->allFinite()) throw Error("holds a found step that is not finite (nan or inf)");
   impl_->last_frame = s.frame;
   impl_->last = s.last;
   impl_->before_last = s.before_last;
@@ -686,13 +723,18 @@ void Tracker::restore(const TrackerState& s) {
 }
 
 void Tracker::replay_stimulus(std::optional<double> stimulus, double time_s) {
-  impl_->feed_stimulus(stimulus, time_s);
+  if (stimulus && !std::isfinite(*stimulus)) {
+    throw InputError(fmt::format("replay_stimulus: the reading is {}; expected a finite number", *stimulus));
+  }
+  if (!std::isfinite(time_s)) throw InputError(fmt::format("replay_stimulus: the time is {}; expected seconds", time_s));
+  impl_->feed_stimulus(stimulus, time_s, -1);
 }
 
 void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
   if (hypothesis.size() != impl_->config.space.dims()) {
     throw Error("set_estimate: expected " + std::to_string(impl_->config.space.dims()) + " parameters");
   }
+  if (!hypothesis.allFinite()) throw Error("set_estimate: the configuration is not finite (nan or inf)");
   impl_->last = impl_->frame.from_world(hypothesis);
   impl_->forget_motion();
   impl_->started = true;
@@ -706,7 +748,7 @@ std::optional<Eigen::VectorXd> Tracker::last_estimate() const {
 const Observation& Tracker::last_observation() const { return impl_->observation; }
 
 CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
-  if (!impl_->started) throw Error("tracker: score() needs a processed frame");
+  if (!impl_->observed) throw Error("tracker: score() needs a frame processed by this tracker");
   if (hypothesis.size() != impl_->config.space.dims()) {
     throw Error("tracker: score() got " + std::to_string(hypothesis.size()) + " parameters, the model has " +
                 std::to_string(impl_->config.space.dims()));
@@ -714,7 +756,7 @@ CostTerms Tracker::score(const Eigen::VectorXd& hypothesis) {
   return impl_->cost->evaluate_one(impl_->frame.from_world(hypothesis));
 }
 CostTerms Tracker::score_after(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& previous) {
-  if (!impl_->started) throw Error("tracker: score_after() needs a processed frame");
+  if (!impl_->observed) throw Error("tracker: score_after() needs a frame processed by this tracker");
   const auto dims = impl_->config.space.dims();
   for (const auto* h : {&hypothesis, &previous}) {
     if (h->size() != dims) {
