@@ -3,7 +3,7 @@
 // Search order (first match wins): the directories given by the user
 // (--plugin-path, then the config's plugin_path), then GTRACK_PLUGIN_PATH
 // (colon-separated), then the plugin folder of the build tree or install
-// prefix next to the executable. A plugin named `foo` lives in
+// prefix that holds libgtrack itself (default_plugin_dir()). A plugin named `foo` lives in
 // libgtrack_foo.so. Each way of failing has its own one-line PluginError:
 // not found (the paths searched and the plugins of that kind that exist),
 // not a gtrack plugin, ABI mismatch (both versions), wrong kind, factory threw

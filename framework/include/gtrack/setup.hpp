@@ -4,7 +4,7 @@
 // (--plugin-path folders, then the config's plugin_path relative to the
 // config file, then GTRACK_PLUGIN_PATH, then the default folder) and makes the
 // three plugins from their tables. The engine's own tables are read by the
-// engine (see tracker_config.hpp) and the root is checked for unknown tables
+// engine (engine_config.hpp) and the root is checked for unknown tables
 // once everything has been read.
 #pragma once
 

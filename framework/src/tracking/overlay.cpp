@@ -3,16 +3,50 @@
 #include "overlay.hpp"
 
 #include <cstdio>
+#include <cstring>
+#include <utility>
 #include <opencv2/imgproc.hpp>
 
 namespace gtrack::detail {
 
+namespace {
+
+// The overlay's font draws ASCII only: the signs of a unit spelt in it.
+std::string in_ascii(const std::string& text) {
+  static const std::pair<const char*, const char*> kSigns[] = {
+      {"\u00B2", "^2"}, {"\u00B3", "^3"}, {"\u00B5", "u"}, {"\u03BC", "u"}, {"\u00B0", "deg "}, {"\u2126", "Ohm"}};
+  std::string out;
+  for (size_t i = 0; i < text.size();) {
+    bool sign = false;
+    for (const auto& [utf8, ascii] : kSigns) {
+      if (text.compare(i, std::strlen(utf8), utf8) == 0) {
+        out += ascii;
+        i += std::strlen(utf8);
+        sign = true;
+        break;
+      }
+    }
+    if (sign) continue;
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x80) {
+      out += text[i++];
+    } else {
+      // Another character: one '?' for its bytes.
+      out += '?';
+      for (++i; i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0) == 0x80; ++i) {
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string reading_text(const Stimulus* stimulus, const Estimate& estimate) {
   if (!stimulus || !estimate.stimulus) return {};
-  char text[96];
-  std::snprintf(text, sizeof text, "%s = %.1f %s", stimulus->reading_label().c_str(), *estimate.stimulus,
-                stimulus->reading_unit().c_str());
-  return text;
+  char value[32];
+  std::snprintf(value, sizeof value, "%.4g", *estimate.stimulus);
+  return in_ascii(stimulus->reading_label() + " = " + value + " " + stimulus->reading_unit());
 }
 
 cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const ArticulatedModel& model,

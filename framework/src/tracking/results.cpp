@@ -170,7 +170,7 @@ std::string estimate_json(const Estimate& e) {
   j += ",\"unseen_fingers\":[";
   for (std::size_t k = 0; k < e.unseen_fingers.size(); ++k) j += (k ? "," : "") + std::to_string(e.unseen_fingers[k]);
   j += "]";
-  j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.4f") : std::string("null"));
+  j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.9g") : std::string("null"));
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);
   if (const auto& r = e.reference_terms) {
