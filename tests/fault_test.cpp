@@ -1041,6 +1041,42 @@ TEST(Fault, ResumeDropsRowsPastTheSavedState) {
   EXPECT_EQ(read_lines(o.out_dir / "estimates.jsonl").size(), static_cast<size_t>(kFrames));
 }
 
+// run_config.toml keeps the fingerprints of the stimulus log and of the
+// plugins' libraries beside the config's files: a log mended in place
+// between the interrupted run and its resumption is refused, as a changed
+// config file is (two runs' readings had been mixed in one table).
+TEST(Fault, ResumeRefusesAStimulusLogChangedSinceTheRunBegan) {
+  const fs::path dir = fresh_dir("resume_log");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, 4);
+  std::ofstream(dir / "stimulus.csv") << "frame,value\n0,22\n3,25\n";
+  o.stimulus_csv = dir / "stimulus.csv";
+  o.range.last = 1;
+  gtrack::track_sequence(r.setup, r.config, o);
+  const auto kept = read_lines(o.out_dir / "run_config.toml");
+  const auto listed = [&](const std::string& start) {
+    return std::any_of(kept.begin(), kept.end(), [&](const std::string& l) { return l.rfind(start, 0) == 0; });
+  };
+  EXPECT_TRUE(listed("# gtrack track: file --stimulus = "));
+  EXPECT_TRUE(listed("# gtrack track: file stimulus plugin temperature_hysteresis = "));
+  EXPECT_TRUE(listed("# gtrack track: file gripper plugin hydrogel_six_finger = "));
+
+  std::ofstream(dir / "stimulus.csv") << "frame,value\n0,22\n3,35\n";
+  o.range.last = -1;
+  o.resume = true;
+  try {
+    gtrack::track_sequence(r.setup, r.config, o);
+    ADD_FAILURE() << "resumed with another stimulus log";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stimulus.csv: has changed since the interrupted run began (--stimulus: it "
+                                         "was 22 bytes"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ofstream(dir / "stimulus.csv") << "frame,value\n0,22\n3,25\n";  // put back: it goes on
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 3);  // frames 1 to 3
+}
+
 // --durable syncs each frame's rows and the state to the disk: the same
 // rows as without, the state at the last frame, no temporary file left.
 // (What it guards against, a power loss, cannot be made here; the fsync

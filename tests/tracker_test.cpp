@@ -516,7 +516,7 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   EXPECT_NE(csv[2].find(",ok,"), std::string::npos);
   const auto jsonl = lines(opt.out_dir / "estimates.jsonl");
   ASSERT_EQ(jsonl.size(), 5u);
-  EXPECT_NE(jsonl[4].find("\"stimulus\":30.0000"), std::string::npos) << jsonl[4];
+  EXPECT_NE(jsonl[4].find("\"stimulus\":30,"), std::string::npos) << jsonl[4];
   EXPECT_NE(jsonl[0].find("\"D\":"), std::string::npos);
   EXPECT_NE(jsonl[0].find("\"unseen_fingers\":["), std::string::npos) << jsonl[0];
   // Each row names its image and when it was written.

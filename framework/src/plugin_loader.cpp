@@ -21,6 +21,14 @@ namespace fs = std::filesystem;
 namespace dll = boost::dll;
 
 namespace {
+// Guards every loader's list of the plugins it made.
+std::mutex& loaded_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+}  // namespace
+
+namespace {
 
 const std::string kPrefix = "libgtrack_";
 const std::string kSuffix = ".so";
@@ -310,6 +318,14 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
   std::shared_ptr<Interface> instance(raw, [lib](Interface* p) { delete p; });
   keep_loaded(lib, file);
   table.check_all_used();
+  {
+    const std::lock_guard<std::mutex> lock(loaded_mutex());
+    rec.file = file;
+    const bool known = std::any_of(loaded_->begin(), loaded_->end(), [&](const PluginRecord& r) {
+      return r.kind == rec.kind && r.name == rec.name && r.file == rec.file;
+    });
+    if (!known) loaded_->push_back(rec);
+  }
   logger().debug("loaded {} plugin '{}' {} from {}", to_string(kind), rec.name, rec.version, file.string());
   return instance;
 }
@@ -338,6 +354,11 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
   } catch (const PluginError& e) {
     throw PluginError(table.where("plugin") + ": " + e.what());
   }
+}
+
+std::vector<PluginRecord> PluginLoader::loaded() const {
+  const std::lock_guard<std::mutex> lock(loaded_mutex());
+  return *loaded_;
 }
 
 std::shared_ptr<Sensor> PluginLoader::make_sensor(const ConfigTable& t) const { return make<Sensor>(t); }

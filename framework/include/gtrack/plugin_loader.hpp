@@ -60,6 +60,10 @@ class GTRACK_API PluginLoader {
   std::shared_ptr<Interface> make_from_file(const std::filesystem::path& file, const std::string& name,
                                             const ConfigTable& table) const;
 
+  // The plugins this loader has made, in order, each once (the file it was
+  // loaded from): what a run records of the code that made its results.
+  std::vector<PluginRecord> loaded() const;
+
   // Reads and checks a library's PluginInfo without calling into it.
   // Throws PluginError on any mismatch.
   static PluginRecord inspect(const std::filesystem::path& file);
@@ -74,6 +78,7 @@ class GTRACK_API PluginLoader {
   std::vector<std::filesystem::path> user_;
   std::vector<std::filesystem::path> env_paths_;
   std::vector<std::filesystem::path> paths_;
+  std::shared_ptr<std::vector<PluginRecord>> loaded_ = std::make_shared<std::vector<PluginRecord>>();
 };
 
 // The directory that holds the running executable.

@@ -184,7 +184,7 @@ ConfigTable load_config(const fs::path& file) {
   return ConfigTable::parse(text, file.string(), base);
 }
 
-void write_run_config(const fs::path& file, const ConfigTable& root, bool durable) {
+void write_run_config(const fs::path& file, const ConfigTable& root, bool durable, const std::vector<NamedFile>& used) {
   std::string from = root.source();
   from = from.empty() ? std::string("<config>") : from.front() == '<' ? shown(from, 1 << 12, true) : encoded(from);
   // A run's own copy given as the config is copied without its header; a
@@ -204,14 +204,16 @@ void write_run_config(const fs::path& file, const ConfigTable& root, bool durabl
   }
   std::string header = std::string(kFirstLine) + std::string(kFromMark) + from + "\n";
   header += std::string(kBaseLine) + encoded(base) + "\n";
-  for (const NamedFile& f : root.named_files()) {
+  std::vector<NamedFile> files = root.named_files();
+  files.insert(files.end(), used.begin(), used.end());
+  for (const NamedFile& f : files) {
     header += std::string(kFileLine) + f.name() + " = " + encoded(f.path) + ": " + fingerprint(f.path) + "\n";
   }
-  header += std::string(kPrefix) + "--resume checks that this config, and the files it names, are unchanged\n";
+  header += std::string(kPrefix) + "--resume checks that this config, and the files listed, are unchanged\n";
   replace_file(file, header + text, durable);
 }
 
-void check_same_config(const fs::path& file, const ConfigTable& root) {
+void check_same_config(const fs::path& file, const ConfigTable& root, const std::vector<NamedFile>& used) {
   std::error_code ec;
   if (!fs::exists(file, ec)) return;
   if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == 0) {
@@ -233,7 +235,8 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
                      "; cannot resume with another config (give the config the run was started with, which this "
                      "file copies and names, or another --out)");
   }
-  const std::vector<NamedFile> current = root.named_files();
+  std::vector<NamedFile> current = root.named_files();
+  current.insert(current.end(), used.begin(), used.end());
   for (const KeptFile& kept : kept_files(file)) {
     const auto it = std::find_if(current.begin(), current.end(), [&](const NamedFile& f) { return f.name() == kept.key; });
     if (it == current.end()) continue;
@@ -247,7 +250,7 @@ void check_same_config(const fs::path& file, const ConfigTable& root) {
     if (path != kept.path && !(kept_path && fs::equivalent(*kept_path, it->path, ec))) {
       throw InputError(copy + ": " + kept.key + " was the file " + kept_shown +
                        " in the interrupted run, is " + path_shown + " with " + now +
-                       "; cannot resume with another file (give a config in the first one's folder, or another --out)");
+                       "; cannot resume with another file (give the files of the interrupted run, or another --out)");
     }
     if (const std::string print = fingerprint(it->path); print != kept.fingerprint) {
       throw InputError(path_shown + ": has changed since the interrupted run began (" + kept.key + ": it was " +

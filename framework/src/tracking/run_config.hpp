@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "gtrack/config.hpp"
 
@@ -33,12 +34,17 @@ std::optional<std::filesystem::path> run_config_base_folder(std::string_view tex
 ConfigTable load_config(const std::filesystem::path& file);
 
 // Writes the copy of `root` (a copy given as the config is copied without
-// its header) with the files root.named_files() lists.
-void write_run_config(const std::filesystem::path& file, const ConfigTable& root, bool durable = false);
+// its header) with the files root.named_files() lists, and `used`: the
+// other files the run's results come from (the stimulus log, the plugins'
+// libraries), each under a name of its own.
+void write_run_config(const std::filesystem::path& file, const ConfigTable& root, bool durable = false,
+                      const std::vector<NamedFile>& used = {});
 
 // Throws InputError, naming the first difference, when `root` is not the
-// config kept in `file`, or a file it names has changed. A run without the
-// copy (from an earlier release) is not checked.
-void check_same_config(const std::filesystem::path& file, const ConfigTable& root);
+// config kept in `file`, or a file it names or one of `used` has changed.
+// A run without the copy (from an earlier release) is not checked, nor a
+// file the copy does not list.
+void check_same_config(const std::filesystem::path& file, const ConfigTable& root,
+                       const std::vector<NamedFile>& used = {});
 
 }  // namespace gtrack::detail

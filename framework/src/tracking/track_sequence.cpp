@@ -377,6 +377,17 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                 (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")) +
                 (options.follow_stimulus ? " followed" : ""),
             1 << 16);
+  // Beside the config and the files it names, what the results come from:
+  // the stimulus log (a followed one cannot be resumed) and the plugins'
+  // libraries. run_config.toml keeps their fingerprints, and a resumed run
+  // refuses to go on once one has changed.
+  std::vector<NamedFile> used;
+  if (options.stimulus_csv && !options.follow_stimulus) used.push_back({"", "--stimulus", *options.stimulus_csv});
+  if (setup.loader) {
+    for (const PluginRecord& p : setup.loader->loaded()) {
+      used.push_back({"", std::string(to_string(p.kind)) + " plugin " + p.name, p.file});
+    }
+  }
   if (options.resume && fs::exists(state_file)) {
     resumed = read_tracker_state(state_file);
     // A state written before the run line named its first frame started
@@ -391,7 +402,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                        "; cannot resume (give the same --input, first frame of --frames, --every and --stimulus, or another "
                        "--out; a run that followed its stimulus log cannot be resumed)");
     }
-    detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root);
+    detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root, used);
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
@@ -543,7 +554,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
   }
   ResultWriter results(options.out_dir, setup.model().fingers(), resumed.has_value());
-  if (!resumed) detail::write_run_config(options.out_dir / detail::kRunConfigName, setup.root, options.durable);
+  if (!resumed) {
+    detail::write_run_config(options.out_dir / detail::kRunConfigName, setup.root, options.durable, used);
+  }
   if (options.save_masks) {
     std::error_code ec;
     fs::create_directories(options.out_dir / "masks", ec);
