@@ -14,6 +14,8 @@
 #include <random>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/model.hpp"
@@ -179,14 +181,13 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   // kelvin is refused), said of their [synth] keys; so is the noise that
   // takes a reading past them.
   const ConfigTable& synth_table = setup.root.table("synth");
-  {
-    auto probe = setup.loader->make_stimulus(setup.root.table("stimulus"));
-    for (const auto& [key, value] : {std::pair{"stimulus_low", p.stimulus_low}, {"stimulus_high", p.stimulus_high}}) {
-      try {
-        probe->update(value, 0);
-      } catch (const std::exception& e) {
-        synth_table.fail(key, e.what());
-      }
+  // (Each end by an instance of its own, as a first reading: a plugin that
+  // checks the time or the rate between readings sees no second one.)
+  for (const auto& [key, value] : {std::pair{"stimulus_low", p.stimulus_low}, {"stimulus_high", p.stimulus_high}}) {
+    try {
+      setup.loader->make_stimulus(setup.root.table("stimulus"))->update(value, 0);
+    } catch (const std::exception& e) {
+      synth_table.fail(key, e.what());
     }
   }
   const int F = model.fingers(), L = model.max_links();
@@ -222,8 +223,11 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
     try {
       stimulus->update(temperature[i], t);
     } catch (const std::exception& e) {
-      synth_table.fail("stimulus_noise", std::string(e.what()) + " (frame " + std::to_string(i) +
-                                             ": the profile with its noise)");
+      synth_table.fail("stimulus_noise",
+                       fmt::format("{} (frame {}, t = {:.3f} s: the profile's reading {:g}, its noise of sigma {:g} "
+                                   "included; keep stimulus_low and stimulus_high three sigma inside what the plugin "
+                                   "takes, or set stimulus_noise lower)",
+                                   e.what(), i, t, temperature[i], p.stimulus_noise));
     }
     if (i > 0) {
       for (int f = 0; f < F; ++f) {
