@@ -218,6 +218,70 @@ TEST(TemperatureHysteresis, BadTablesAreRejected) {
   EXPECT_THROW(make_stimulus("plugin = \"temperature_hysteresis\"\nresponse_s = -1"), gtrack::ConfigError);
 }
 
+// threshold_hysteresis is temperature_hysteresis's model in the units the
+// config names: given the Celsius plugin's thresholds, margin and trend
+// threshold, it follows the same readings to the same states, penalties
+// and biases, in both modes.
+TEST(ThresholdHysteresis, IsTheTemperaturePluginsModelInAnyUnit) {
+  const std::string same = "band_margin = 0.5\nreading_min = -50\nreading_max = 150\ntrend_threshold_per_s = 0.005\n";
+  const std::vector<std::pair<std::string, std::string>> pairs = {
+      {"plugin = \"temperature_hysteresis\"\nsettle_s = 1.5",
+       "plugin = \"threshold_hysteresis\"\nsettle_s = 1.5\nunfold_below = 24\nfold_above = 27\n" + same},
+      {std::string(kMetallic) + "\nresponse_s = 0.5",
+       "plugin = \"threshold_hysteresis\"\nmode = \"latching\"\ntrigger = 37\nfolded_deg = 70\ntolerance_deg = "
+       "8\nresponse_s = 0.5\n" + same}};
+  for (const auto& [celsius, neutral] : pairs) {
+    auto a = make_stimulus(celsius), b = make_stimulus(neutral);
+    const std::vector<double> joints{-5, 12, 30, 61, 80};
+    for (int i = 0; i < 120; ++i) {
+      const double reading = 22 + 17 * std::sin(i / 15.0) + (i % 7) * 0.1;  // heats past 37, cools, heats
+      a->update(reading, i / 10.0);
+      b->update(reading, i / 10.0);
+      ASSERT_EQ(a->state().feasible_min_deg, b->state().feasible_min_deg) << neutral << ", reading " << i;
+      ASSERT_EQ(a->state().feasible_max_deg, b->state().feasible_max_deg) << neutral << ", reading " << i;
+      ASSERT_EQ(a->fold_fraction(), b->fold_fraction()) << neutral << ", reading " << i;
+      ASSERT_EQ(a->penalty(joints), b->penalty(joints)) << neutral << ", reading " << i;
+      ASSERT_EQ(a->target_joint_deg(30), b->target_joint_deg(30)) << neutral << ", reading " << i;
+    }
+  }
+}
+
+// Its unit, label and reading range come from the table; the thresholds
+// of the mode in use have no default.
+TEST(ThresholdHysteresis, TakesItsUnitsFromTheTableAndNeedsItsThresholds) {
+  auto s = make_stimulus(
+      "plugin = \"threshold_hysteresis\"\nunfold_below = 5\nfold_above = 12\nreading_min = 0\nreading_max = 50\n"
+      "label = \"B\"\nunit = \"mT\"");
+  EXPECT_EQ(s->reading_label(), "B");
+  EXPECT_EQ(s->reading_unit(), "mT");
+  s->update(3, 0);
+  EXPECT_DOUBLE_EQ(s->state().feasible_max_deg, 10);  // unfolded (0) within the 10 deg tolerance
+  try {
+    s->update(80, 1);
+    ADD_FAILURE() << "a reading past reading_max was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_STREQ(e.what(), "a reading of 80, outside the 0 to 50 mT threshold_hysteresis takes: expected a reading "
+                           "within reading_min and reading_max");
+  }
+  const auto error = [](const std::string& table) {
+    try {
+      make_stimulus(table);
+    } catch (const gtrack::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("plugin = \"threshold_hysteresis\"\nunfold_below = 5").find("fold_above"), std::string::npos);
+  EXPECT_NE(error("plugin = \"threshold_hysteresis\"\nmode = \"latching\"").find("trigger"), std::string::npos);
+  EXPECT_NE(error("plugin = \"threshold_hysteresis\"\nunfold_below = 5\nfold_above = 12\nreading_min = 9\n"
+                  "reading_max = 2")
+                .find("reading_max"),
+            std::string::npos);
+  EXPECT_NE(error("plugin = \"threshold_hysteresis\"\nunfold_below = 5\nfold_above = 12\nfold_above_C = 3")
+                .find("fold_above_C"),
+            std::string::npos);  // a Celsius key is not one of its keys
+}
+
 }  // namespace
 
 // A stimulus table whose reference joints differ from the gripper's is
