@@ -134,15 +134,28 @@ TEST(StimulusLog, FollowTakesAppendedWholeLines) {
   EXPECT_TRUE(log.poll());
   EXPECT_DOUBLE_EQ(*log.latest(), 23.0);
   EXPECT_EQ(log.rows(), 2u);
-  append("2,abc\n");
-  try {
-    log.poll();
-    FAIL() << "a malformed appended row must be refused";
-  } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("gtrack_stimulus_follow.csv:4: expected a number in the value field, got 'abc'"),
-              std::string::npos)
-        << e.what();
-  }
+  // A garbled row and one whose key steps back are said and left out: a
+  // live run goes on, holding the last reading.
+  append("2,abc\n1,30\n3,24.5\n");
+  const std::string said = gtrack::testing::logged([&] { EXPECT_TRUE(log.poll()); });
+  EXPECT_NE(said.find("gtrack_stimulus_follow.csv:4: expected a number in the value field, got 'abc'; the row is left "
+                      "out, and the frames hold the last reading"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("gtrack_stimulus_follow.csv:5: expected a frame index greater than the previous row's"), std::string::npos)
+      << said;
+  EXPECT_EQ(log.skipped_rows(), 2);
+  EXPECT_EQ(log.rows(), 3u);
+  EXPECT_DOUBLE_EQ(*log.latest(), 24.5);
+  // A reading the check refuses is no glitch: it stops the run.
+  const fs::path checked = fs::temp_directory_path() / "gtrack_stimulus_follow_checked.csv";
+  std::ofstream(checked) << "frame,value\n0,22\n";
+  gtrack::StimulusLog strict = gtrack::StimulusLog::follow(checked, [](double v, gtrack::StimulusLog::Key, double) {
+    if (v > 150) throw std::invalid_argument("too hot");
+  });
+  std::ofstream(checked, std::ios::app) << "1,295\n";
+  EXPECT_THROW(strict.poll(), gtrack::InputError);
+  fs::remove(checked);
   std::ofstream(file) << "frame,value\n";
   EXPECT_THROW(log.poll(), gtrack::InputError);  // shrank: a new log, not this one
 }

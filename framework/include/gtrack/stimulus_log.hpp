@@ -38,11 +38,16 @@ class GTRACK_API StimulusLog {
   // A log still being written (a live run): poll() takes the rows appended
   // since the last call, whole lines only, with the same checks as parse()
   // (errors name the file and line); true when rows were added. The file may
-  // be empty, or hold only its header, at first.
+  // be empty, or hold only its header, at first. A malformed row, or one
+  // whose key does not increase, is warned about and left out (counted by
+  // skipped_rows()); a bad header, a reading the check refuses, a file that
+  // shrinks or is replaced by one without the rows read so far throw.
   static StimulusLog follow(const std::filesystem::path& file, ReadingCheck check = {});
   bool poll();
   // The last row's reading; nullopt while there is none.
   std::optional<double> latest() const;
+  // follow(): the rows left out as malformed.
+  int skipped_rows() const { return skipped_rows_; }
 
   Key key() const { return key_; }
   // The reading for a frame (index and time); nullopt outside the log.
@@ -68,6 +73,8 @@ class GTRACK_API StimulusLog {
   std::filesystem::path followed_;       // follow(): the file
   std::streamoff read_to_ = 0;           // follow(): bytes taken (whole lines)
   bool gone_ = false;                    // follow(): the file is missing, and that was said
+  bool refused_ = false;                 // the last row was refused by the check (not malformed)
+  int skipped_rows_ = 0;                 // follow(): malformed rows left out
   // follow(): the bytes just before read_to_, which the file (or one put in
   // its place) must still hold.
   std::string tail_;

@@ -256,6 +256,7 @@ struct TrackSummary {
   int frames_before = 0;     // --resume: rows kept from before; `frames` counts this run's only
   std::string input_ended_early;  // FrameSource::ended_early: "" when the input ended where it said it would
   int skipped_frames = 0;    // TrackOptions::newest: frames read and left out for a newer one
+  int skipped_stimulus_rows = 0;  // follow_stimulus: malformed rows of the log left out (warned about)
   std::string stopped_by;    // the error that stopped the run part way ("" when none; it is then thrown on)
 };
 

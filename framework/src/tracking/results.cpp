@@ -213,6 +213,7 @@ void write_summary(const fs::path& file, const TrackSummary& s) {
       << "  \"frames_before_resume\": " << s.frames_before << ",\n"
       << "  \"cancelled\": " << (s.cancelled ? "true" : "false") << ",\n"
       << "  \"skipped_frames\": " << s.skipped_frames << ",\n"
+      << "  \"skipped_stimulus_rows\": " << s.skipped_stimulus_rows << ",\n"
       << "  \"input_ended_early\": " << (s.input_ended_early.empty() ? "null" : json_string(s.input_ended_early))
       << ",\n"
       << "  \"stopped_by\": " << (s.stopped_by.empty() ? "null" : json_string(s.stopped_by)) << "\n"

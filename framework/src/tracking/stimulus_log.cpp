@@ -108,6 +108,7 @@ void StimulusLog::take_line(std::string line) {
     try {
       check_(v, key_, k);
     } catch (const std::exception& e) {
+      refused_ = true;
       throw InputError(where + e.what());
     }
   }
@@ -173,7 +174,18 @@ bool StimulusLog::poll() {
   size_t start = 0;
   while (start <= end) {
     const size_t nl = fresh.find('\n', start);
-    take_line(fresh.substr(start, nl - start));
+    try {
+      refused_ = false;
+      take_line(fresh.substr(start, nl - start));
+    } catch (const InputError& e) {
+      // A live run goes on past a row the logger garbled (a glitch, a
+      // clock that stepped back): said, left out, the frames holding the
+      // last reading. A header that is not one, or a reading the plugin
+      // refuses (a log in another unit), still stops it.
+      if (!header_ || refused_) throw;
+      logger().warn("{}; the row is left out, and the frames hold the last reading", e.what());
+      ++skipped_rows_;
+    }
     start = nl + 1;
   }
   read_to_ += static_cast<std::streamoff>(end + 1);

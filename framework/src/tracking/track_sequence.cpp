@@ -628,6 +628,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
     summary.input_ended_early = source->ended_early();
     summary.skipped_frames = reader.skipped();
+    if (log) summary.skipped_stimulus_rows = log->skipped_rows();
     summary.mean_ms = ms_sum / n;
     summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
     summary.wall_s = seconds_since(start);

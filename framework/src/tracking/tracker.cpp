@@ -672,6 +672,7 @@ void Tracker::reset() {
   // The stimulus plugin starts again too: made anew from its table where
   // the setup has a loader (its state has no reset of its own).
   if (impl_->setup.stimulus && impl_->setup.loader && impl_->setup.root.has("stimulus")) {
+    impl_->cost->set_stimulus(nullptr);  // set again from the new one by the next frame
     impl_->setup.stimulus = impl_->setup.loader->make_stimulus(impl_->setup.root.table("stimulus"));
   }
   impl_->last.reset();
