@@ -31,6 +31,10 @@ namespace gtrack {
 // it is all a run needs to continue where it stopped, with the same results.
 struct TrackerState {
   int frame = -1;  // the last frame processed; -1 = none
+  // In the sensor's frame (Tracker's class comment). `last` is the result
+  // the track goes on from: before unseen fingers take the seen fingers'
+  // fold, so its joints can differ from the reported Estimate::hypothesis;
+  // restore() continues exactly, set_estimate(e.hypothesis) does not.
   std::optional<Eigen::VectorXd> last, before_last;
   // `last` came from a search (coarse search or re-detection); the x, y step
   // between two such estimates of consecutive frames (none: -).
