@@ -31,17 +31,6 @@ void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) 
             << "  max " << std::setw(8) << s.max << " " << unit << "\n";
 }
 
-// A sensor that images a slab (an ultrasound slice: two clip planes facing
-// each other across the viewing axis) has its "in-plane" error within the
-// imaging plane and its "depth" error across it, not below the probe.
-bool images_a_slab(const gtrack::Sensor& sensor) {
-  const gtrack::Projection p = sensor.projection();
-  if (p.clip_planes.size() != 2) return false;
-  const Eigen::Vector3d axis = gtrack::viewing_axis(p);
-  const Eigen::Vector3d a = p.clip_planes[0].head<3>().normalized(), b = p.clip_planes[1].head<3>().normalized();
-  return std::abs(std::abs(a.dot(axis)) - 1) < 1e-6 && a.dot(b) < -1 + 1e-6;
-}
-
 // What estimates.jsonl says of a frame: the occlusion allowance, and, from
 // 'gtrack track --score-truth', the estimate's and the truth's costs and how
 // much of the truth's silhouette fell outside O.
@@ -337,7 +326,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     std::cout << "  no frame in view has an estimate: there are no error figures\n";
   } else {
     print_row("position 3D", ev.in_view.position_um, "um");
-    const bool slab = images_a_slab(*setup.sensor);
+    const bool slab = gtrack::cli::images_a_slab(*setup.sensor);
     print_row(slab ? "in the imaging plane" : "position in-plane", ev.in_view.position_inplane_um, "um");
     print_row(slab ? "across the plane" : "depth", ev.in_view.depth_um, "um");
     print_row("orientation", ev.in_view.orientation_deg, "deg");

@@ -9,6 +9,7 @@
 #include <boost/program_options.hpp>
 #include <gtrack/frame_source.hpp>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "gtrack/error.hpp"
+#include "gtrack/sensor.hpp"
 
 namespace gtrack::cli {
 
@@ -154,6 +156,17 @@ inline std::uint64_t seed_option(const boost::program_options::variables_map& vm
     throw UsageError("--seed: expected a whole number of at least 0, got '" + text + "'");
   }
   return seed;
+}
+
+// A sensor that images a slab (an ultrasound slice: two clip planes facing
+// each other across the viewing axis) has its "in-plane" error within the
+// imaging plane and its "depth" error across it, not below the probe.
+inline bool images_a_slab(const gtrack::Sensor& sensor) {
+  const gtrack::Projection p = sensor.projection();
+  if (p.clip_planes.size() != 2) return false;
+  const Eigen::Vector3d axis = gtrack::viewing_axis(p);
+  const Eigen::Vector3d a = p.clip_planes[0].head<3>().normalized(), b = p.clip_planes[1].head<3>().normalized();
+  return std::abs(std::abs(a.dot(axis)) - 1) < 1e-6 && a.dot(b) < -1 + 1e-6;
 }
 
 }  // namespace gtrack::cli
