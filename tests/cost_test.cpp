@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "gtrack/cost.hpp"
+#include "gtrack/error.hpp"
 
 namespace {
 
@@ -12,7 +13,7 @@ class CountsRenderer final : public gtrack::Renderer {
  public:
   std::vector<gtrack::PairCounts> counts;
   std::uint64_t observed = 0;
-  int submitted = 0;
+  int submitted = 0, finished = 0;
   std::string name() const override { return "counts"; }
   void set_model(const gtrack::ArticulatedModel&) override {}
   void set_projection(const gtrack::Projection&, double) override {}
@@ -24,7 +25,10 @@ class CountsRenderer final : public gtrack::Renderer {
     ++submitted;
     n_ = static_cast<int>(h.cols());
   }
-  void finish(std::vector<gtrack::PairCounts>& out) override { out.assign(counts.begin(), counts.begin() + n_); }
+  void finish(std::vector<gtrack::PairCounts>& out) override {
+    ++finished;
+    out.assign(counts.begin(), counts.begin() + n_);
+  }
   cv::Mat render_mask(const Eigen::VectorXd&) override { return {}; }
 
  private:
@@ -56,6 +60,36 @@ class FixedStimulus final : public gtrack::Stimulus {
   double fold_fraction() const override { return 0.5; }
   double target_joint_deg(double c) const override { return c; }
 };
+
+// A plugin's error while the renderers work on a batch (a stimulus's
+// unusable penalty) reaches the caller, and every batch is collected first:
+// the gl renderer, left with a batch pending, had refused every later one.
+TEST(Cost, APluginErrorDuringABatchLeavesNoBatchPending) {
+  struct Failing final : gtrack::Stimulus {
+    bool fail = true;
+    void update(double, double) override {}
+    gtrack::StimulusState state() const override { return {}; }
+    double penalty(std::span<const double>) const override {
+      if (fail) throw gtrack::PluginError("stimulus plugin 'failing': penalty() returned nan");
+      return 0;
+    }
+    double fold_fraction() const override { return 0.5; }
+    double target_joint_deg(double c) const override { return c; }
+  };
+  CountsRenderer a, b;
+  a.counts = b.counts = {{10, 10}, {10, 10}};
+  FixedGripper g;
+  Failing s;
+  gtrack::CostEvaluator eval({&a, &b}, g, &s, gtrack::CostWeights{});
+  const Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  std::vector<gtrack::CostTerms> t;
+  EXPECT_THROW(eval.evaluate(h, t), gtrack::PluginError);
+  EXPECT_EQ(a.finished, a.submitted);
+  EXPECT_EQ(b.finished, b.submitted);
+  s.fail = false;
+  eval.evaluate(h, t);
+  EXPECT_EQ(t.size(), 2u);
+}
 
 TEST(Cost, DiceDistanceFromCounts) {
   EXPECT_DOUBLE_EQ(gtrack::dice_distance(100, 100, 100), 0.0);  // identical

@@ -467,6 +467,19 @@ TEST(Fault, AnOutputLockIsTakenAgainWithinAProcessAndHeldUntilTheLastRelease) {
     const gtrack::OutputLock outer(o.out_dir);
     EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 2);
     EXPECT_FALSE(others_can_lock()) << "the run's end released the lock its caller holds";
+    // Another thread of the process is another run: refused.
+    std::string refused;
+    std::thread([&] {
+      try {
+        const gtrack::OutputLock other(o.out_dir);
+      } catch (const gtrack::InputError& e) {
+        refused = e.what();
+      }
+    }).join();
+    EXPECT_NE(refused.find("another gtrack track run is writing there (pid " + std::to_string(::getpid()) +
+                           ", this process, another thread)"),
+              std::string::npos)
+        << refused;
     std::ifstream pid(o.out_dir / ".gtrack_lock");
     EXPECT_EQ(std::string(std::istreambuf_iterator<char>(pid), {}), std::to_string(::getpid()));
   }

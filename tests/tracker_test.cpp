@@ -387,6 +387,7 @@ TEST(Tracker, ARefusedFrameTimeOrReadingLeavesTheTrackerAsItWas) {
   // A reading the plugin refuses names the frame and the reading.
   EXPECT_EQ(message(0.033, 295.0).rfind("frame 1 (t = 0.033 s): the stimulus plugin refused the reading 295: ", 0), 0u)
       << message(0.033, 295.0);
+  EXPECT_EQ(tracker.state().frame, before.frame);
   EXPECT_THROW(tracker.set_estimate(Eigen::VectorXd::Constant(12, std::nan(""))), gtrack::Error);
 }
 
@@ -402,6 +403,28 @@ TEST(Tracker, ResetStartsTheStimulusAgain) {
   for (int i = 0; i < 4; ++i) used.process(frame, i, i / 30.0, 22.0 + 5 * i);  // heated past its fold
   used.reset();
   EXPECT_EQ(used.process(frame, 0, 0.0, 22.0).hypothesis, first.hypothesis);
+}
+
+// A stimulus the application put in the Setup itself is its own: reset()
+// leaves it (and its state) as it is.
+TEST(Tracker, ResetKeepsAStimulusTheApplicationSet) {
+  struct Counting final : gtrack::Stimulus {
+    int updates = 0;
+    void update(double, double) override { ++updates; }
+    gtrack::StimulusState state() const override { return {}; }
+    double penalty(std::span<const double>) const override { return 0; }
+    double fold_fraction() const override { return 0.5; }
+    double target_joint_deg(double c) const override { return c; }
+  };
+  auto setup = make_setup();
+  auto own = std::make_shared<Counting>();
+  setup.stimulus = own;
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  const cv::Mat frame = scene(setup, pose(0.3, -0.2, 20, 5), 1);
+  tracker.process(frame, 0, 0.0, 24.0);
+  tracker.reset();
+  tracker.process(frame, 0, 0.0, 24.0);
+  EXPECT_EQ(own->updates, 2);
 }
 
 // After restore() the tracker holds no observation: score() says so.

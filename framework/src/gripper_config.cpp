@@ -9,8 +9,12 @@ namespace gtrack {
 
 std::vector<LinkShape> links_from_config(const ConfigTable& t, const std::vector<double>& lengths,
                                          const std::vector<double>& widths) {
+  if (widths.size() != lengths.size() + 1) {
+    t.fail("link_widths_mm", "expected " + std::to_string(lengths.size() + 1) + " widths (one more than the " +
+                                 std::to_string(lengths.size()) + " links), got " + std::to_string(widths.size()));
+  }
   std::vector<LinkShape> links;
-  for (size_t j = 0; j < lengths.size() && j + 1 < widths.size(); ++j) {
+  for (size_t j = 0; j < lengths.size(); ++j) {
     if (widths[j] <= 0 && widths[j + 1] <= 0) {
       t.fail("link_widths_mm", "link " + std::to_string(j + 1) + " is 0 wide at both ends; a link needs a width at "
                                                                      "one end at least");

@@ -46,7 +46,7 @@ HysteresisStimulus::HysteresisStimulus(const ConfigTable& t, HysteresisUnits uni
   triggered_ = t.boolean_or("triggered", false);
   if (!latching_ && !(unfold_below_ < fold_above_)) t.fail(fold_key, "must be greater than " + unfold_key);
   if (folded_ == unfolded_) t.fail("folded_deg", "must differ from unfolded_deg");
-  name_ = t.string_or("plugin", "");
+  name_ = t.string_or("plugin", "the stimulus plugin");
   state_.value = latching_ && !units_.unfold_below ? trigger_ : unfold_below_;
   refresh();
 }
@@ -54,8 +54,9 @@ HysteresisStimulus::HysteresisStimulus(const ConfigTable& t, HysteresisUnits uni
 void HysteresisStimulus::update(double value, double time_s) {
   if (std::isfinite(value) && (value < units_.lowest || value > units_.highest)) {
     const std::string hint = units_.refused_hint ? units_.refused_hint(value) : std::string();
-    throw InputError(fmt::format("a reading of {:g}, outside the {:g} to {:g} {} {} takes: expected {}{}", value,
-                                 units_.lowest, units_.highest, units_.unit, name_, units_.quantity, hint));
+    throw InputError(fmt::format("a reading of {:g}, outside the {:g} to {:g}{} {} takes: expected {}{}", value,
+                                 units_.lowest, units_.highest, units_.unit.empty() ? "" : " " + units_.unit, name_,
+                                 units_.quantity, hint));
   }
   if (std::isfinite(value)) {
     if (has_prev_ && time_s > prev_time_) {

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
@@ -26,24 +27,13 @@ std::mutex& loaded_mutex() {
   static std::mutex mutex;
   return mutex;
 }
-}  // namespace
-
-namespace {
 
 const std::string kPrefix = "libgtrack_";
 const std::string kSuffix = ".so";
 
-fs::path library_dir() {
-  // The folder of libgtrack.so itself: right for the gtrack executable, the
-  // tests and any program that links the framework, installed or not.
-  static const fs::path dir = [] {
-    std::error_code ec;
-    fs::path p = dll::this_line_location(ec);
-    if (ec) p = dll::program_location(ec);
-    return fs::weakly_canonical(p).parent_path();
-  }();
-  return dir;
-}
+// The folder of libgtrack.so itself: right for the gtrack executable, the
+// tests and any program that links the framework, installed or not.
+fs::path library_dir() { return framework_library_file().parent_path(); }
 
 fs::path prefix_dir() {
   fs::path p = library_dir();
@@ -327,6 +317,8 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
     if (!known) loaded_->push_back(rec);
   }
   logger().debug("loaded {} plugin '{}' {} from {}", to_string(kind), rec.name, rec.version, file.string());
+  // A stimulus's results are checked as the tracker takes them.
+  if constexpr (std::is_same_v<Interface, Stimulus>) return std::make_shared<detail::CheckedStimulus>(instance, name);
   return instance;
 }
 
@@ -356,6 +348,16 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
   }
 }
 
+fs::path framework_library_file() {
+  static const fs::path file = [] {
+    std::error_code ec;
+    fs::path p = dll::this_line_location(ec);
+    if (ec) p = dll::program_location(ec);
+    return fs::weakly_canonical(p);
+  }();
+  return file;
+}
+
 std::vector<PluginRecord> PluginLoader::loaded() const {
   const std::lock_guard<std::mutex> lock(loaded_mutex());
   return *loaded_;
@@ -363,9 +365,7 @@ std::vector<PluginRecord> PluginLoader::loaded() const {
 
 std::shared_ptr<Sensor> PluginLoader::make_sensor(const ConfigTable& t) const { return make<Sensor>(t); }
 std::shared_ptr<Gripper> PluginLoader::make_gripper(const ConfigTable& t) const { return make<Gripper>(t); }
-std::shared_ptr<Stimulus> PluginLoader::make_stimulus(const ConfigTable& t) const {
-  return std::make_shared<detail::CheckedStimulus>(make<Stimulus>(t), t.string("plugin"));
-}
+std::shared_ptr<Stimulus> PluginLoader::make_stimulus(const ConfigTable& t) const { return make<Stimulus>(t); }
 
 template GTRACK_API std::shared_ptr<Sensor> PluginLoader::make_from_file<Sensor>(const fs::path&, const std::string&,
                                                                                  const ConfigTable&) const;

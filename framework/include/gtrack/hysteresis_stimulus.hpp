@@ -64,6 +64,9 @@ struct HysteresisUnits {
   std::string (*refused_hint)(double value) = nullptr;
 };
 
+// A plugin deriving from it holds its members: a plugin built against one
+// gtrack release is refused by another whose plugin ABI differs
+// (GTRACK_PLUGIN_ABI_VERSION), which a change to this class's layout bumps.
 class GTRACK_API HysteresisStimulus : public Stimulus {
  public:
   // Reads the table's keys (named as `units` says) and fails on any that

@@ -50,7 +50,9 @@ class GTRACK_API PluginLoader {
 
   // Loads the plugin named by table["plugin"], checks it, constructs it from
   // the table and checks that every key of the table was read. The instance
-  // keeps its library loaded for as long as it lives.
+  // keeps its library loaded for as long as it lives. A stimulus comes
+  // wrapped so that its results are checked as they are used (a NaN
+  // penalty, a range upside down: PluginError naming it).
   std::shared_ptr<Sensor> make_sensor(const ConfigTable& table) const;
   std::shared_ptr<Gripper> make_gripper(const ConfigTable& table) const;
   std::shared_ptr<Stimulus> make_stimulus(const ConfigTable& table) const;
@@ -80,6 +82,9 @@ class GTRACK_API PluginLoader {
   std::vector<std::filesystem::path> paths_;
   std::shared_ptr<std::vector<PluginRecord>> loaded_ = std::make_shared<std::vector<PluginRecord>>();
 };
+
+// The file of the framework library itself (libgtrack.so).
+GTRACK_API std::filesystem::path framework_library_file();
 
 // The directory that holds the running executable.
 GTRACK_API std::filesystem::path executable_dir();

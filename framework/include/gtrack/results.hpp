@@ -36,9 +36,10 @@ class GTRACK_API ResultWriter {
 // An exclusive lock on an output folder (flock on DIR/.gtrack_lock, which
 // holds the owner's pid), held while a run writes there: a second process
 // writing into the folder is refused with an InputError naming that pid.
-// Within one process it is taken again freely (track_sequence() and
+// The thread that holds it takes it again freely (track_sequence() and
 // two_pass() each take it; a caller that holds one across both keeps
-// another run out between them). It goes with the process, however it
+// another run out between them); another thread is refused as another
+// process is. It goes with the process, however it
 // ends. A file system without locks (some network mounts) runs without one.
 class GTRACK_API OutputLock {
  public:

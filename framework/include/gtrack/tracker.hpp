@@ -140,8 +140,9 @@ class GTRACK_API Tracker {
   Estimate process(const cv::Mat& frame, int index, double time_s, std::optional<double> stimulus);
 
   // Forget the history: the next frame starts like the first. The stimulus
-  // plugin is made anew from the config's [stimulus] table when the Setup
-  // has its loader (load_setup's do); otherwise it keeps its state.
+  // plugin is made anew from the config's [stimulus] table when the
+  // Setup's loader made it (load_setup's Setups; PluginError if it can no
+  // longer be loaded); a stimulus the application set itself keeps its state.
   void reset();
   // The history, in the frame the tracker searches in (the class comment).
   TrackerState state() const;

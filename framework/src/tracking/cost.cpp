@@ -78,15 +78,28 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
   for (auto& t : out) t.dice = t.dice_without_rim = 0;
   // Every renderer starts its batch first; K and S are computed while they work.
   for (Renderer* r : renderers_) r->submit(hypotheses);
-  for (int i = 0; i < n; ++i) {
-    const int joints = static_cast<int>(hypotheses.rows()) - kPoseDims;
-    std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
-    out[i].kinematic = gripper_->kinematic_penalty(q);
-    out[i].stimulus = stimulus_ ? stimulus_->penalty(q) : 0.0;
-    out[i].coherence = joint_coherence(q, weights_.coherence_sigma_deg);
-    out[i].temporal = (prediction_.size() > 0 && weights_.temporal > 0)
-                          ? temporal_distance(hypotheses.col(i), prediction_, sigma_, wrap_rz_)
-                          : 0.0;
+  try {
+    for (int i = 0; i < n; ++i) {
+      const int joints = static_cast<int>(hypotheses.rows()) - kPoseDims;
+      std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
+      out[i].kinematic = gripper_->kinematic_penalty(q);
+      out[i].stimulus = stimulus_ ? stimulus_->penalty(q) : 0.0;
+      out[i].coherence = joint_coherence(q, weights_.coherence_sigma_deg);
+      out[i].temporal = (prediction_.size() > 0 && weights_.temporal > 0)
+                            ? temporal_distance(hypotheses.col(i), prediction_, sigma_, wrap_rz_)
+                            : 0.0;
+    }
+  } catch (...) {
+    // A plugin's error (a stimulus's unusable penalty): the batches are
+    // collected all the same, so that the renderers can take the next one.
+    for (Renderer* r : renderers_) {
+      try {
+        r->finish(counts_);
+      } catch (...) {
+        // The plugin's error is the one to report.
+      }
+    }
+    throw;
   }
   for (Renderer* r : renderers_) {
     r->finish(counts_);

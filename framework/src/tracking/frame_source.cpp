@@ -37,6 +37,21 @@ void FrameSource::set_image_bits(int bits) {
   image_bits_ = bits;
 }
 
+namespace {
+
+// Grey and alpha, or BGRA: the colour channels only.
+cv::Mat without_alpha(const cv::Mat& image) {
+  cv::Mat out = image;
+  if (out.channels() == 2) {
+    cv::extractChannel(out, out, 0);
+  } else if (out.channels() == 4) {
+    cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
+  }
+  return out;
+}
+
+}  // namespace
+
 cv::Mat to_tracker_image(const cv::Mat& image, int image_bits, const std::string& name) {
   if (image.depth() != CV_8U && image.depth() != CV_16U) {
     const char* depth = image.depth() == CV_32F   ? "32-bit float"
@@ -54,12 +69,7 @@ cv::Mat to_tracker_image(const cv::Mat& image, int image_bits, const std::string
   if (image_bits < 1 || image_bits > 16) {
     throw InputError(name + ": image_bits is " + std::to_string(image_bits) + "; expected 1 to 16");
   }
-  cv::Mat out = image;
-  if (out.channels() == 2) {  // grey and alpha
-    cv::extractChannel(out, out, 0);
-  } else if (out.channels() == 4) {
-    cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
-  }
+  cv::Mat out = without_alpha(image);
   if (out.depth() == CV_16U) out.convertTo(out, CV_8U, 255.0 / (std::ldexp(1.0, image_bits) - 1.0));
   if (out.channels() == 1) cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
   return out;
@@ -72,8 +82,8 @@ cv::Mat FrameSource::to_bgr(const cv::Mat& image, const std::string& name) {
     // in 16-bit files).
     checked_bits_ = true;
     const double top = std::ldexp(1.0, image_bits_) - 1.0;
-    double max = 0;
-    cv::minMaxLoc(image.reshape(1), nullptr, &max);
+    double max = 0;  // of the colour channels: an opaque alpha is 65535
+    cv::minMaxLoc(without_alpha(image).reshape(1), nullptr, &max);
     if (max > 0 && max < (top + 1) / 16) {
       logger().warn("{}: a 16-bit image whose values reach only {} of {:.0f}, so it is dark at 8 bits; if the "
                     "camera gives fewer bits, say so with [tracker] image_bits (now {})",

@@ -14,6 +14,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
@@ -329,6 +330,7 @@ namespace {
 struct HeldLock {
   int fd = -1;
   int count = 0;
+  std::thread::id owner;  // taken again by this thread only: another thread's run is refused
 };
 std::mutex g_held_mutex;
 std::map<std::string, HeldLock> g_held;
@@ -346,6 +348,11 @@ OutputLock::OutputLock(const fs::path& out_dir) {
   key_ = ec ? fs::absolute(file).lexically_normal().string() : canonical.string();
   const std::lock_guard<std::mutex> guard(g_held_mutex);
   if (HeldLock& held = g_held[key_]; held.count > 0) {
+    if (held.owner != std::this_thread::get_id()) {
+      throw InputError(out_dir.string() + ": another gtrack track run is writing there (pid " +
+                       std::to_string(::getpid()) + ", this process, another thread); wait for it to end, or "
+                       "choose another --out");
+    }
     ++held.count;
     return;
   }
@@ -371,7 +378,7 @@ OutputLock::OutputLock(const fs::path& out_dir) {
   }
   const std::string me = std::to_string(::getpid());
   if (::ftruncate(fd, 0) == 0) (void)!::pwrite(fd, me.data(), me.size(), 0);
-  g_held[key_] = HeldLock{fd, 1};
+  g_held[key_] = HeldLock{fd, 1, std::this_thread::get_id()};
 }
 
 OutputLock::~OutputLock() {

@@ -378,11 +378,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                 (options.follow_stimulus ? " followed" : ""),
             1 << 16);
   // Beside the config and the files it names, what the results come from:
-  // the stimulus log (a followed one cannot be resumed) and the plugins'
-  // libraries. run_config.toml keeps their fingerprints, and a resumed run
-  // refuses to go on once one has changed.
+  // the stimulus log (a followed one cannot be resumed), the framework's
+  // library and the plugins'. run_config.toml keeps their fingerprints, and
+  // a resumed run refuses to go on once one has changed.
   std::vector<NamedFile> used;
   if (options.stimulus_csv && !options.follow_stimulus) used.push_back({"", "--stimulus", *options.stimulus_csv});
+  used.push_back({"", "gtrack library", framework_library_file()});
   if (setup.loader) {
     for (const PluginRecord& p : setup.loader->loaded()) {
       used.push_back({"", std::string(to_string(p.kind)) + " plugin " + p.name, p.file});

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "checked_stimulus.hpp"
 #include "coarse_search.hpp"
 #include "gtrack/cmaes.hpp"
 #include "gtrack/error.hpp"
@@ -179,24 +180,27 @@ struct Tracker::Impl {
 
     // Observation: around the previous estimate while it is trusted, the
     // whole image when there is none or it has been lost for too long. A
-    // frame refused here (its size or type) leaves the tracker as it was.
+    // frame refused here (its size or type), or its reading by the stimulus
+    // plugin, leaves the tracker as it was.
     const cv::Mat frame = setup.sensor->rectify(input);
     const bool searching = !last || lost >= config.tracker.reinit_after_lost;
     std::uint64_t previous_area = 0;  // |P| of the previous estimate, render pixels
+    Observation fresh;
     if (!searching) {
       ObservationPrior prior;
       prior.previous_mask = renderer->render_mask(*last);
       prior.margin_scale = 1.0 + lost;
       previous_area = whole_area(*last, prior.previous_mask);
-      observation = segmenter->observe(frame, &prior);
+      fresh = segmenter->observe(frame, &prior);
     } else {
-      observation = segmenter->observe(frame, nullptr);
+      fresh = segmenter->observe(frame, nullptr);
     }
+    reading = feed_stimulus(reading, time_s, index);
+    observation = std::move(fresh);
     last_frame = index;
 
-    reading = feed_stimulus(reading, time_s, index);
     const bool stimulus_on = reading.has_value() && setup.stimulus != nullptr;
-    e.stimulus = stimulus_on ? reading : std::nullopt;
+    e.stimulus = reading;
     cost->set_stimulus(stimulus_on ? setup.stimulus.get() : nullptr);
     // Occlusion handling (docs/tracker.md, "Partial occlusion"): the
     // constant-velocity prediction for the temporal term, and, when O is
@@ -406,6 +410,7 @@ struct Tracker::Impl {
         forget_motion();
         e.hypothesis = *last;
         e.unseen_fingers.clear();
+        e.redetected = e.mirrored = false;
         e.terms = cost->evaluate_one(*last);
       } else {
         lost = 0;
@@ -669,9 +674,11 @@ Tracker::Tracker(Tracker&&) noexcept = default;
 Tracker& Tracker::operator=(Tracker&&) noexcept = default;
 
 void Tracker::reset() {
-  // The stimulus plugin starts again too: made anew from its table where
-  // the setup has a loader (its state has no reset of its own).
-  if (impl_->setup.stimulus && impl_->setup.loader && impl_->setup.root.has("stimulus")) {
+  // The stimulus plugin starts again too: made anew from its table when the
+  // loader made it (its state has no reset of its own). A stimulus the
+  // application put in the Setup itself is left as it is.
+  const bool from_loader = dynamic_cast<const detail::CheckedStimulus*>(impl_->setup.stimulus.get()) != nullptr;
+  if (from_loader && impl_->setup.loader && impl_->setup.root.has("stimulus")) {
     impl_->cost->set_stimulus(nullptr);  // set again from the new one by the next frame
     impl_->setup.stimulus = impl_->setup.loader->make_stimulus(impl_->setup.root.table("stimulus"));
   }
