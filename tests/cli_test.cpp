@@ -228,7 +228,7 @@ TEST(Cli, TrackRefusesAReadingTheStimulusPluginCannotTake) {
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_NE(r.output.find((dir / "kelvin.csv").string() +
                             ":3: a reading of 295.15, outside the -50 to 150 C temperature_hysteresis takes: "
-                            "expected degrees Celsius (kelvin: subtract 273.15)"),
+                            "expected degrees Celsius (kelvin: subtract 273.15, or set log_unit = \"K\")"),
               std::string::npos)
         << r.output;
     EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));

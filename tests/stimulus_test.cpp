@@ -202,12 +202,44 @@ TEST(TemperatureHysteresis, RefusesAReadingThatIsNotCelsius) {
     s->update(296.15, 2);
     ADD_FAILURE() << "a reading in kelvin was taken";
   } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("expected degrees Celsius (kelvin: subtract 273.15)"),
+    EXPECT_NE(std::string(e.what()).find("expected degrees Celsius (kelvin: subtract 273.15, or set log_unit = \"K\")"),
               std::string::npos)
         << e.what();
   }
   EXPECT_THROW(s->update(-60, 3), gtrack::InputError);
   EXPECT_DOUBLE_EQ(s->state().value, -50);  // the refused readings changed nothing
+}
+
+// log_unit: a log in Fahrenheit or kelvin is taken as the same temperatures
+// in Celsius (read as Celsius, 80 F had been a hot 80 C); the overlay's unit
+// is the log's, and a refused reading is said in it.
+TEST(TemperatureHysteresis, ALogInFahrenheitOrKelvinIsTheSameTemperatures) {
+  const std::string settle = "\nsettle_s = 1";
+  auto c = make_stimulus(std::string(kHydrogel) + settle);
+  auto f = make_stimulus(std::string(kHydrogel) + settle + "\nlog_unit = \"F\"");
+  auto k = make_stimulus(std::string(kHydrogel) + settle + "\nlog_unit = \"K\"");
+  const std::vector<double> joints{-5, 12, 30, 61};
+  for (int i = 0; i < 80; ++i) {
+    const double celsius = 25.5 + 4.5 * std::sin(i / 9.0);  // through the 24-27 C band and back
+    c->update(celsius, i / 10.0);
+    f->update(celsius * 9 / 5 + 32, i / 10.0);
+    k->update(celsius + 273.15, i / 10.0);
+    for (const auto* other : {&f, &k}) {
+      ASSERT_NEAR((*other)->state().feasible_min_deg, c->state().feasible_min_deg, 1e-9) << i;
+      ASSERT_NEAR((*other)->state().feasible_max_deg, c->state().feasible_max_deg, 1e-9) << i;
+      ASSERT_NEAR((*other)->penalty(joints), c->penalty(joints), 1e-9) << i;
+      ASSERT_EQ((*other)->fold_fraction(), c->fold_fraction()) << i;
+    }
+  }
+  EXPECT_EQ(f->reading_unit(), "F");
+  EXPECT_EQ(k->reading_unit(), "K");
+  try {
+    f->update(400, 9);
+    ADD_FAILURE() << "400 F was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_STREQ(e.what(), "a reading of 400, outside the -58 to 302 F temperature_hysteresis takes: expected degrees "
+                           "Fahrenheit (log_unit = \"F\")");
+  }
 }
 
 TEST(TemperatureHysteresis, BadTablesAreRejected) {

@@ -51,11 +51,16 @@ HysteresisStimulus::HysteresisStimulus(const ConfigTable& t, HysteresisUnits uni
   refresh();
 }
 
-void HysteresisStimulus::update(double value, double time_s) {
+void HysteresisStimulus::update(double reading, double time_s) {
+  // In the thresholds' unit.
+  const double value = reading * units_.reading_scale + units_.reading_offset;
   if (std::isfinite(value) && (value < units_.lowest || value > units_.highest)) {
-    const std::string hint = units_.refused_hint ? units_.refused_hint(value) : std::string();
-    throw InputError(fmt::format("a reading of {:g}, outside the {:g} to {:g}{} {} takes: expected {}{}", value,
-                                 units_.lowest, units_.highest, units_.unit.empty() ? "" : " " + units_.unit, name_,
+    // Said in the log's unit.
+    const double a = (units_.lowest - units_.reading_offset) / units_.reading_scale;
+    const double b = (units_.highest - units_.reading_offset) / units_.reading_scale;
+    const std::string hint = units_.refused_hint ? units_.refused_hint(reading) : std::string();
+    throw InputError(fmt::format("a reading of {:g}, outside the {:g} to {:g}{} {} takes: expected {}{}", reading,
+                                 std::min(a, b), std::max(a, b), units_.unit.empty() ? "" : " " + units_.unit, name_,
                                  units_.quantity, hint));
   }
   if (std::isfinite(value)) {

@@ -53,13 +53,17 @@ struct HysteresisUnits {
   // The thresholds' defaults; nullopt: the key is required in the mode
   // that reads it.
   std::optional<double> unfold_below, fold_above, trigger;
-  // Readings (and thresholds) outside [lowest, highest] are refused.
+  // A reading in the log's unit is reading_scale * value + reading_offset
+  // in the thresholds' (a log in Fahrenheit for thresholds in Celsius).
+  double reading_scale = 1, reading_offset = 0;
+  // Readings (and thresholds) outside [lowest, highest], in the
+  // thresholds' unit, are refused.
   double lowest = -1e9, highest = 1e9;
   // The folding range is entered this far before its nominal edges.
   double band_margin = 0;
-  // For the overlay and messages: "T", "C", and what a reading is
-  // ("degrees Celsius"); `refused_hint` is added to the message of a
-  // refused reading (a kelvin log's, say) when it returns text for it.
+  // For the overlay and messages: "T", the log's unit ("C"), and what a
+  // reading is ("degrees Celsius"); `refused_hint` is added to the message
+  // of a refused reading (a kelvin log's, say) when it returns text for it.
   std::string label = "s", unit, quantity = "the plugin's unit";
   std::string (*refused_hint)(double value) = nullptr;
 };
