@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The plugin SDK as a lab uses it: install gtrack to a fresh prefix, build the
-# out-of-tree examples (a sensor, a gripper and a stimulus) against it, list
+# out-of-tree examples (a sensor, a gripper and two stimuli, one of them on
+# the SDK's hysteresis model) against it, list
 # them with the installed gtrack, and track short synthetic sequences with
 # them and with the gripper defined only in TOML, checking the errors against
 # thresholds.
@@ -13,7 +14,7 @@ prefix="$work/prefix"
 
 cmake --install "$build_dir" --prefix "$prefix" > "$work/install.log"
 gtrack="$prefix/bin/gtrack"
-for ex in light_stimulus three_finger_gripper telecentric_sensor; do
+for ex in light_stimulus three_finger_gripper telecentric_sensor field_latch; do
   cmake -S "examples/$ex" -B "$work/$ex" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > "$work/$ex.log"
   cmake --build "$work/$ex" >> "$work/$ex.log"
 done
@@ -21,12 +22,14 @@ done
 cmake --install "$work/light_stimulus" >> "$work/light_stimulus.log"
 env -u GTRACK_PLUGIN_PATH "$gtrack" plugins | grep -q $'^stimulus\tlight_intensity\t' ||
   { echo "ci_examples: light_intensity installed with GTRACK_PLUGIN_INSTALL_DIR is not found"; exit 1; }
-paths=(--plugin-path "$work/light_stimulus" --plugin-path "$work/three_finger_gripper" --plugin-path "$work/telecentric_sensor")
+paths=(--plugin-path "$work/light_stimulus" --plugin-path "$work/three_finger_gripper" --plugin-path "$work/telecentric_sensor"
+       --plugin-path "$work/field_latch")
 listing=$(env -u GTRACK_PLUGIN_PATH "$gtrack" plugins "${paths[@]}")
 echo "$listing"
 grep -q $'^stimulus\tlight_intensity\t' <<< "$listing" || { echo "ci_examples: light_intensity not listed"; exit 1; }
 grep -q $'^gripper\tthree_finger_gripper\t' <<< "$listing" || { echo "ci_examples: three_finger_gripper not listed"; exit 1; }
 grep -q $'^sensor\ttelecentric_microscope\t' <<< "$listing" || { echo "ci_examples: telecentric_microscope not listed"; exit 1; }
+grep -q $'^stimulus\tfield_latch\t' <<< "$listing" || { echo "ci_examples: field_latch not listed"; exit 1; }
 
 # mean of a metric in an evaluation JSON
 mean_of() { sed -n "s/.*\"$2\": {\"mean\": \([-0-9.e+]*\).*/\1/p" "$1" | head -n1; }
@@ -74,4 +77,11 @@ echo "ci_examples: examples: the joints fold to $folded deg"
 # the occlusion rim (114 um, 21 deg) fails them.
 run_setup custom_gripper "$prefix/share/gtrack/configs/microscope_custom_gripper.toml" 60 \
   "${CUSTOM_MAX_UM:-100}" "${CUSTOM_MAX_DEG:-20}" "${CUSTOM_MAX_JOINT_DEG:-6}"
+# The SDK's hysteresis model under a lab's own keys and unit (mT): a field
+# from 3 to 12 mT releases the latch at 9 mT, and the two-finger gripper
+# folds. The gripper is 0.75 mm long: a lost track is off by hundreds of um.
+run_setup field_latch examples/field_setup.toml 40 "${FIELD_MAX_UM:-30}" "${FIELD_MAX_DEG:-45}" "${FIELD_MAX_JOINT_DEG:-10}"
+folded=$(sed -n 's/.*joints: [-0-9.e+]* to \([-0-9.e+]*\) deg.*/\1/p' "$work/field_latch.synth.log")
+awk -v v="${folded:-0}" 'BEGIN { exit !(v >= 20) }' || { echo "ci_examples: the field sequence does not fold (joints up to '$folded' deg)"; exit 1; }
+echo "ci_examples: field_latch: the joints fold to $folded deg"
 echo "ci_examples: passed"
