@@ -77,6 +77,11 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::TrackOptions opt;
   opt.input = vm["input"].as<std::string>();
   if (vm.count("stimulus")) opt.stimulus_csv = vm["stimulus"].as<std::string>();
+  if (vm.count("stimulus-column")) {
+    if (!opt.stimulus_csv) throw gtrack::cli::UsageError("--stimulus-column needs --stimulus");
+    opt.stimulus_column = vm["stimulus-column"].as<std::string>();
+    if (opt.stimulus_column.empty()) throw gtrack::cli::UsageError("--stimulus-column: expected a column's name");
+  }
   opt.out_dir = gtrack::cli::out_folder(vm);
   opt.range = gtrack::cli::frame_range_option(vm);
   opt.save_masks = vm.count("save-masks") > 0;
@@ -222,6 +227,8 @@ GTRACK_COMMAND(
       d.add_options()("config,c", po::value<std::string>()->required(), "TOML config naming sensor, gripper, stimulus")(
           "input,i", po::value<std::string>()->required(), "video file, folder of images, TIFF stack, or camera:N")(
           "stimulus,s", po::value<std::string>(), "stimulus log CSV (frame,value or time_s,value)")(
+          "stimulus-column", po::value<std::string>(),
+          "of a stimulus log with several named columns (time_s,B_mT,T_C), the one that holds the readings")(
           "out,o", po::value<std::string>()->required(), "output folder")(
           "backend", po::value<std::string>(), "auto, gl or cpu (default: [render] backend)")(
           "every", po::value<int>()->default_value(1), "track every K-th frame")(

@@ -42,7 +42,10 @@ TEST(StimulusLog, TimeKeyedUsesFrameTime) {
 }
 
 TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
-  EXPECT_EQ(error_of("frame,temp\n"), "log.csv:1: expected the header 'frame,value' or 'time_s,value', got 'frame,temp'");
+  EXPECT_EQ(error_of("index,temp\n"), "log.csv:1: expected the header 'frame,value' or 'time_s,value' (or the key and "
+                                       "named columns, 'time_s,B_mT,T_C'), got 'index,temp'");
+  EXPECT_EQ(error_of("frame,\n"), "log.csv:1: expected the header 'frame,value' or 'time_s,value' (or the key and "
+                                  "named columns, 'time_s,B_mT,T_C'), got 'frame,'");
   EXPECT_EQ(error_of("frame,value\n0,20\n1,abc\n"), "log.csv:3: expected a number in the value field, got 'abc'");
   EXPECT_EQ(error_of("frame,value\n0,20\n1.5,21\n"),
             "log.csv:3: expected a frame index (a whole number from 0 to 2147483647) in the first field, got '1.5'");
@@ -84,6 +87,30 @@ TEST(StimulusLog, AReadingTheCheckRefusesNamesItsLine) {
   }
   EXPECT_EQ(at.back(), 0.5);
   EXPECT_EQ(keys.back(), StimulusLog::Key::Time);
+}
+
+// A logger's own header: the readings' column may have any name, and of
+// several named columns the one asked for is read (a log had to be
+// rewritten to 'frame,value' first).
+TEST(StimulusLog, ALoggersNamedColumnsAreReadByName) {
+  const auto one = StimulusLog::parse("time_s,B_mT\n0,2.5\n1,4.5\n", "log.csv");
+  EXPECT_DOUBLE_EQ(*one.value_at(15, 0.5), 3.5);
+  const std::string channels = "time_s,B_mT,T_C\n0,2.5,22\n1,4.5,24\n";
+  EXPECT_DOUBLE_EQ(*StimulusLog::parse(channels, "log.csv", {}, "T_C").value_at(15, 0.5), 23.0);
+  EXPECT_DOUBLE_EQ(*StimulusLog::parse(channels, "log.csv", {}, "B_mT").value_at(15, 0.5), 3.5);
+  const auto error = [&](const std::string& text, const std::string& column) {
+    try {
+      StimulusLog::parse(text, "log.csv", {}, column);
+    } catch (const gtrack::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error(channels, ""), "log.csv:1: the log has the columns 'B_mT', 'T_C'; say which holds the readings "
+                                 "(gtrack track --stimulus-column NAME)");
+  EXPECT_EQ(error(channels, "T_F"), "log.csv:1: no column 'T_F'; the log has 'B_mT', 'T_C'");
+  EXPECT_EQ(error("time_s,B_mT,T_C\n0,2.5\n", "T_C"), "log.csv:2: expected 3 fields, as the header has, got '0,2.5'");
+  EXPECT_EQ(error("time_s,B_mT,T_C\n0,2.5,hot\n", "T_C"), "log.csv:2: expected a number in the 'T_C' field, got 'hot'");
 }
 
 TEST(StimulusLog, MissingFileIsAnInputError) {

@@ -2,7 +2,10 @@
 //
 // Two forms, chosen by the header: `frame,value` (one row per frame index;
 // frames between rows take the linearly interpolated value) or
-// `time_s,value` (interpolated at the frame's time, index / fps). Rows must
+// `time_s,value` (interpolated at the frame's time, index / fps). The
+// readings' column may have another name (`time_s,B_mT`), and a log of
+// several named columns (a logger's channels, `time_s,B_mT,T_C`) is read
+// from the one `column` names (required then; an error lists them). Rows must
 // be increasing in the key column. A malformed row is an InputError
 // "file:line: expected <what>, got '<text>'". A frame before the first or
 // after the last row is outside the log: value_at() returns nullopt and the
@@ -32,9 +35,10 @@ class GTRACK_API StimulusLog {
 
   using ReadingCheck = std::function<void(double value, Key key, double at)>;
 
-  static StimulusLog load(const std::filesystem::path& file, ReadingCheck check = {});
+  static StimulusLog load(const std::filesystem::path& file, ReadingCheck check = {},
+                          const std::string& column = "");
   static StimulusLog parse(const std::string& text, const std::string& source = "<string>",
-                           ReadingCheck check = {});
+                           ReadingCheck check = {}, const std::string& column = "");
   // A log still being written (a live run): poll() takes the rows appended
   // since the last call, whole lines only, with the same checks as parse()
   // (errors name the file and line); true when rows were added. The file may
@@ -42,7 +46,8 @@ class GTRACK_API StimulusLog {
   // whose key does not increase, is warned about and left out (counted by
   // skipped_rows()); a bad header, a reading the check refuses, a file that
   // shrinks or is replaced by one without the rows read so far throw.
-  static StimulusLog follow(const std::filesystem::path& file, ReadingCheck check = {});
+  static StimulusLog follow(const std::filesystem::path& file, ReadingCheck check = {},
+                            const std::string& column = "");
   bool poll();
   // The last row's reading; nullopt while there is none.
   std::optional<double> latest() const;
@@ -65,6 +70,10 @@ class GTRACK_API StimulusLog {
   void take_line(std::string line);
 
   Key key_ = Key::Frame;
+  std::string column_;       // the readings' column asked for ("": the only one)
+  std::string value_name_;   // the readings' column, as the header names it
+  size_t value_field_ = 1;   // its place in a row
+  size_t field_count_ = 2;   // the fields of a row
   std::vector<double> keys_, values_;
   std::string source_;
   ReadingCheck check_;

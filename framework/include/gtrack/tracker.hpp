@@ -193,6 +193,9 @@ class GTRACK_API Tracker {
 struct TrackOptions {
   std::string input;                          // video file, image folder or "camera:N"
   std::optional<std::filesystem::path> stimulus_csv;
+  // The log's column of readings when it has several named ones (a
+  // logger's channels); "" = its only one (StimulusLog).
+  std::string stimulus_column;
   std::filesystem::path out_dir;
   FrameRange range;                           // --frames A:B, --every K
   bool save_masks = false;                    // out_dir/masks/NNNNNN.png (observation O)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
@@ -30,15 +31,26 @@ bool parse_number(const std::string& text, double& out) {
   return ec == std::errc() && end == t.data() + t.size() && std::isfinite(out);
 }
 
+// The fields of a line, trimmed.
+std::vector<std::string> fields_of(const std::string& line) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  for (size_t comma; (comma = line.find(',', start)) != std::string::npos; start = comma + 1) {
+    out.push_back(trim(line.substr(start, comma - start)));
+  }
+  out.push_back(trim(line.substr(start)));
+  return out;
+}
+
 // A field as it is quoted in a message: short, printable ASCII.
-std::string quoted(const std::string& text) { return "'" + shown(text, 60, true) + "'"; }
+std::string field_text(const std::string& text) { return "'" + shown(text, 60, true) + "'"; }
 
 // A row of a stimulus log is a few dozen characters.
 constexpr size_t kMaxLine = 4096;
 
 }  // namespace
 
-StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck check) {
+StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck check, const std::string& column) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
     throw InputError(file.string() + ": is a folder; expected a stimulus log (a CSV file)");
@@ -50,13 +62,15 @@ StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck ch
     text += line;
     text += '\n';
   }
-  return parse(text, file.string(), std::move(check));
+  return parse(text, file.string(), std::move(check), column);
 }
 
-StimulusLog StimulusLog::parse(const std::string& text, const std::string& source, ReadingCheck check) {
+StimulusLog StimulusLog::parse(const std::string& text, const std::string& source, ReadingCheck check,
+                               const std::string& column) {
   StimulusLog log;
   log.source_ = source;
   log.check_ = std::move(check);
+  log.column_ = column;
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line)) log.take_line(std::move(line));
@@ -73,36 +87,59 @@ void StimulusLog::take_line(std::string line) {
   if (lineno == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
   const std::string t = trim(line);
   if (t.empty() || t[0] == '#') return;
-  const auto comma = t.find(',');
-  const std::string a = comma == std::string::npos ? t : trim(t.substr(0, comma));
-  const std::string b = comma == std::string::npos ? "" : trim(t.substr(comma + 1));
+  const std::vector<std::string> fields = fields_of(t);
   const std::string where = source_ + ":" + std::to_string(lineno) + ": ";
   if (!header_) {
-    if (comma == std::string::npos || b != "value" || (a != "frame" && a != "time_s")) {
-      throw InputError(where + "expected the header 'frame,value' or 'time_s,value', got " + quoted(t));
+    // The key, then one column of readings or several named ones (a
+    // logger's channels), of which `column_` is taken.
+    const bool keyed = fields.size() >= 2 && (fields[0] == "frame" || fields[0] == "time_s");
+    const bool named = std::all_of(fields.begin() + std::min<size_t>(1, fields.size()), fields.end(),
+                                   [](const std::string& f) { return !f.empty(); });
+    if (!keyed || !named) {
+      throw InputError(where + "expected the header 'frame,value' or 'time_s,value' (or the key and named columns, " +
+                       "'time_s,B_mT,T_C'), got " + field_text(t));
     }
-    key_ = a == "frame" ? Key::Frame : Key::Time;
+    std::string names;
+    for (size_t i = 1; i < fields.size(); ++i) names += (i > 1 ? ", " : "") + field_text(fields[i]);
+    if (column_.empty() && fields.size() > 2) {
+      throw InputError(where + "the log has the columns " + names +
+                       "; say which holds the readings (gtrack track --stimulus-column NAME)");
+    }
+    const auto at = column_.empty() ? fields.begin() + 1 : std::find(fields.begin() + 1, fields.end(), column_);
+    if (at == fields.end()) throw InputError(where + "no column " + field_text(column_) + "; the log has " + names);
+    key_ = fields[0] == "frame" ? Key::Frame : Key::Time;
+    value_field_ = static_cast<size_t>(at - fields.begin());
+    field_count_ = fields.size();
+    value_name_ = *at;
     header_ = true;
     return;
   }
   const char* key_name = key_ == Key::Frame ? "a frame index" : "a time in seconds";
   double k = 0, v = 0;
-  if (comma == std::string::npos || b.find(',') != std::string::npos) {
-    throw InputError(where + "expected two fields '<" + std::string(key_ == Key::Frame ? "frame" : "time_s") +
-                     ">,<value>', got " + quoted(t));
+  if (fields.size() != field_count_) {
+    const std::string key_field = key_ == Key::Frame ? "frame" : "time_s";
+    throw InputError(where + "expected " +
+                     (field_count_ == 2 ? "two fields '<" + key_field + ">,<value>'"
+                                        : std::to_string(field_count_) + " fields, as the header has") +
+                     ", got " + field_text(t));
   }
+  const std::string& a = fields[0];
+  const std::string& b = fields[value_field_];
   if (!parse_number(a, k) || (key_ == Key::Frame && (k < 0 || k != std::floor(k) || k > 2147483647.0))) {
     throw InputError(where + "expected " +
                      (key_ == Key::Frame ? std::string("a frame index (a whole number from 0 to 2147483647)")
                                          : std::string(key_name)) +
-                     " in the first field, got " + quoted(a));
+                     " in the first field, got " + field_text(a));
   }
-  if (!parse_number(b, v)) throw InputError(where + "expected a number in the value field, got " + quoted(b));
+  if (!parse_number(b, v)) {
+    throw InputError(where + "expected a number in the " + (value_name_ == "value" ? "value" : field_text(value_name_)) +
+                     " field, got " + field_text(b));
+  }
   // No sensor of a lab reads past this in any unit; larger values are a
   // unit or logging mistake, and overflow the interpolation.
-  if (std::abs(v) > 1e9) throw InputError(where + "expected a reading of magnitude up to 1e9, got " + quoted(b));
+  if (std::abs(v) > 1e9) throw InputError(where + "expected a reading of magnitude up to 1e9, got " + field_text(b));
   if (!keys_.empty() && !(k > keys_.back())) {
-    throw InputError(where + "expected " + key_name + " greater than the previous row's, got " + quoted(a));
+    throw InputError(where + "expected " + key_name + " greater than the previous row's, got " + field_text(a));
   }
   if (check_) {
     try {
@@ -116,10 +153,11 @@ void StimulusLog::take_line(std::string line) {
   values_.push_back(v);
 }
 
-StimulusLog StimulusLog::follow(const std::filesystem::path& file, ReadingCheck check) {
+StimulusLog StimulusLog::follow(const std::filesystem::path& file, ReadingCheck check, const std::string& column) {
   StimulusLog log;
   log.source_ = file.string();
   log.check_ = std::move(check);
+  log.column_ = column;
   log.followed_ = file;
   std::ifstream probe(file, std::ios::binary);
   if (!probe) throw InputError(file.string() + ": cannot open the stimulus log");

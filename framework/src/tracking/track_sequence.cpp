@@ -375,6 +375,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       shown("input=" + (options.input.rfind("camera:", 0) == 0 ? options.input : absolute(options.input)) +
                 " from=" + std::to_string(range.first) + " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
                 (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")) +
+                (options.stimulus_column.empty() ? std::string() : " column=" + options.stimulus_column) +
                 (options.follow_stimulus ? " followed" : ""),
             1 << 16);
   // Beside the config and the files it names, what the results come from:
@@ -400,7 +401,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (!ran.empty() && ran != run) {
       throw InputError(state_file.string() + ": the interrupted run tracked " + shown(ran, 300) +
                        "; this one " + shown(run, 300) +
-                       "; cannot resume (give the same --input, first frame of --frames, --every and --stimulus, or another "
+                       "; cannot resume (give the same --input, first frame of --frames, --every, --stimulus and --stimulus-column, or another "
                        "--out; a run that followed its stimulus log cannot be resumed)");
     }
     detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root, used);
@@ -454,8 +455,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         probe->update(value, key == StimulusLog::Key::Time ? at : at / fps);
       };
     }
-    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check))
-                                  : StimulusLog::load(*options.stimulus_csv, std::move(check));
+    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check), options.stimulus_column)
+                                  : StimulusLog::load(*options.stimulus_csv, std::move(check), options.stimulus_column);
   }
   const int expected = expected_frames(*source, range);
   const std::string described = source->description();
