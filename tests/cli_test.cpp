@@ -865,7 +865,8 @@ TEST(Cli, UsageErrors) {
   r = gtrack("bench --batch 0");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--batch must be in 1-4096 hypotheses"), std::string::npos) << r.output;
-  r = gtrack("track -c x.toml -i frames --stimulus-column B_mT --out " + out.string());
+  r = gtrack("track -c " + (fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml").string() +
+             " -i frames --stimulus-column B_mT --out " + out.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--stimulus-column needs --stimulus"), std::string::npos) << r.output;
 }
