@@ -22,6 +22,11 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   o.joint_noise_deg = vm["joint-noise"].as<double>();
   o.occlusion_scale = vm["occlusion-scale"].as<double>();
   o.threads = vm["threads"].as<int>();
+  if (vm.count("stimulus")) o.stimulus_log = vm["stimulus"].as<std::string>();
+  if (vm.count("stimulus-column")) {
+    if (!o.stimulus_log) throw gtrack::cli::UsageError("--stimulus-column needs --stimulus");
+    o.stimulus_column = vm["stimulus-column"].as<std::string>();
+  }
   if (o.threads < 0) throw gtrack::cli::UsageError("--threads must be 0 (all cores) or more");
   if (o.frames < 1) throw gtrack::cli::UsageError("--frames must be at least 1");
   if (!(o.joint_noise_deg >= 0 && o.joint_noise_deg <= 90)) {
@@ -83,11 +88,16 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
             << "  partly out of view (10-99% inside): " << s.partly_out_frames << ", out of view (<10% inside): "
             << s.out_of_view_frames << "\n"
             << std::defaultfloat << std::setprecision(6)  // readings in any unit: significant digits
-            << "  stimulus: " << s.stimulus_min << " to " << s.stimulus_max << unit << " (the profile's range: "
-            << s.stimulus_low << " to " << s.stimulus_high << unit << "), " << std::fixed << std::setprecision(1)
+            << "  stimulus: " << s.stimulus_min << " to " << s.stimulus_max << unit
+            << (o.stimulus_log ? " (from " + o.stimulus_log->string() + ")"
+                               : " (the profile's range: " + fmt::format("{:g} to {:g}", s.stimulus_low, s.stimulus_high) +
+                                     unit + ")")
+            << ", " << std::fixed << std::setprecision(1)
             << "joints: " << s.joint_min_deg << " to " << s.joint_max_deg << " deg\n";
   // From 2.5 s on, a sequence holds a whole heating and cooling cycle.
-  if (s.duration_s >= 2.5 && s.joint_max_deg - s.joint_min_deg < 1) {
+  if (o.stimulus_log && s.joint_max_deg - s.joint_min_deg < 1) {
+    std::cout << "  note: the joints do not fold: the log's readings never cross the plugin's fold band\n";
+  } else if (s.duration_s >= 2.5 && s.joint_max_deg - s.joint_min_deg < 1) {
     std::cout << "  note: the joints do not fold: the stimulus never crosses the plugin's fold band; set "
                  "stimulus_low and stimulus_high in the config's [synth] table\n";
   }
@@ -118,6 +128,10 @@ GTRACK_COMMAND(
           "occlusion-scale", po::value<double>()->default_value(1.0),
           "multiplies each occluder's share of the shape, in [0, 1]; 0 = no occluders, the rest of the sequence "
           "unchanged")(
-          "threads", po::value<int>()->default_value(0), "frames drawn in parallel (0 = all cores)");
+          "threads", po::value<int>()->default_value(0), "frames drawn in parallel (0 = all cores)")(
+          "stimulus", po::value<std::string>(),
+          "a lab's stimulus log (frame,value or time_s,value) that drives the material instead of the preset's "
+          "profile")(
+          "stimulus-column", po::value<std::string>(), "of a log with several named columns, the readings' one");
     },
     run_synth)

@@ -142,6 +142,31 @@ TEST(Synth, SameSeedSameSequence) {
   EXPECT_EQ(cv::norm(fa, fb, cv::NORM_INF), 0);
 }
 
+// A lab's own stimulus log drives the material in place of the profile:
+// each frame takes the log's reading (interpolated, the nearest past its
+// end), the joints follow it, and the seed's motion stays as it was.
+TEST(Synth, ALabsStimulusLogDrivesTheMaterial) {
+  const gtrack::Setup setup = microscope();
+  gtrack::SynthOptions o;
+  o.frames = 90;
+  o.seed = 4;
+  const auto profile = gtrack::plan_sequence(setup, o);
+  const fs::path log = fs::temp_directory_path() / "gtrack_synth_lab_log.csv";
+  // Held cold for a second, heated past the 24-27 C band, then the log ends.
+  std::ofstream(log) << "time_s,T_C,humidity\n0,22,40\n1,22,40\n2,32,41\n";
+  o.stimulus_log = log;
+  o.stimulus_column = "T_C";
+  const auto lab = gtrack::plan_sequence(setup, o);
+  fs::remove(log);
+  for (int i = 0; i < o.frames; ++i) {
+    const double t = i / 30.0;
+    EXPECT_DOUBLE_EQ(lab.frames[i].stimulus, t <= 1 ? 22.0 : t <= 2 ? 22 + 10 * (t - 1) : 32.0) << "frame " << i;
+    EXPECT_EQ(lab.frames[i].truth.head<6>(), profile.frames[i].truth.head<6>()) << "frame " << i;
+  }
+  EXPECT_LT(lab.frames[25].truth[gtrack::kPoseDims], 1.0);   // still cold: unfolded
+  EXPECT_GT(lab.frames[89].truth[gtrack::kPoseDims], 20.0);  // heated: folding
+}
+
 TEST(Synth, OcclusionScaleShrinksTheOccludersAndKeepsTheRest) {
   const gtrack::Setup setup = microscope();
   gtrack::SynthOptions o;

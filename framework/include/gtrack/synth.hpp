@@ -18,6 +18,8 @@
 // setup is a new entry there.
 #pragma once
 
+#include <optional>
+
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
@@ -91,6 +93,13 @@ struct SynthOptions {
   // sequence with smaller occluders, or none.
   double occlusion_scale = 1;
   int threads = 0;  // frames drawn in parallel; 0 = hardware concurrency
+  // A lab's own stimulus log (StimulusLog: frame- or time-keyed, its
+  // `stimulus_column` of several) drives the material in place of the
+  // preset's profile: each frame takes the log's reading at its time (the
+  // nearest row's past the log's ends). The rest of the seed's sequence
+  // (motion, occluders, look) stays the same.
+  std::optional<std::filesystem::path> stimulus_log;
+  std::string stimulus_column;
 };
 
 struct OccluderPlan {

@@ -19,6 +19,7 @@
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/model.hpp"
+#include "gtrack/stimulus_log.hpp"
 #include "gtrack/synth.hpp"
 #include "synth/appearance.hpp"
 #include "synth/smooth_path.hpp"
@@ -165,7 +166,12 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   const auto prx = SmoothPath(rng, base_hz).sample(times), pry = SmoothPath(rng, base_hz).sample(times);
   const auto prz = SmoothPath(rng, base_hz).sample(times);
   const auto exits = plan_exits(p, duration, half_view, radius, nominal.head<2>(), rng);
-  const auto temperature = stimulus_profile(p, times, duration, rng);
+  auto temperature = stimulus_profile(p, times, duration, rng);  // drawn with a log too: the seed's rest stays
+  std::optional<StimulusLog> lab_log;
+  if (options.stimulus_log) {
+    lab_log = StimulusLog::load(*options.stimulus_log, {}, options.stimulus_column);
+    for (int i = 0; i < n; ++i) temperature[i] = lab_log->value_at(i, times[i]).value_or(lab_log->nearest(i, times[i]));
+  }
   auto occluders = plan_occlusions(p, n, fps, rng);
   for (OccluderPlan& o : occluders) {
     o.target *= options.occlusion_scale;
@@ -184,6 +190,7 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   // (Each end by an instance of its own, as a first reading: a plugin that
   // checks the time or the rate between readings sees no second one.)
   for (const auto& [key, value] : {std::pair{"stimulus_low", p.stimulus_low}, {"stimulus_high", p.stimulus_high}}) {
+    if (lab_log) break;  // the log's rows are the readings
     try {
       setup.loader->make_stimulus(setup.root.table("stimulus"))->update(value, 0);
     } catch (const std::exception& e) {
@@ -223,6 +230,10 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
     try {
       stimulus->update(temperature[i], t);
     } catch (const std::exception& e) {
+      if (lab_log) {
+        throw InputError(fmt::format("{}: frame {} (t = {:.3f} s): the stimulus plugin refused the reading {:g}: {}",
+                                     lab_log->source(), i, t, temperature[i], e.what()));
+      }
       synth_table.fail("stimulus_noise",
                        fmt::format("{} (frame {}, t = {:.3f} s: the profile's reading {:g}, its noise of sigma {:g} "
                                    "included; keep stimulus_low and stimulus_high three sigma inside what the plugin "
