@@ -346,12 +346,15 @@ OutputLock::OutputLock(const fs::path& out_dir) {
   // folder this process holds is counted, not locked again.
   const fs::path canonical = fs::weakly_canonical(file, ec);
   key_ = ec ? fs::absolute(file).lexically_normal().string() : canonical.string();
+  // `who`: " (pid N)", or "" when the lock file does not say.
+  const auto busy = [&](const std::string& who) {
+    return InputError(out_dir.string() + ": another gtrack track run is writing there" + who +
+                      "; wait for it to end, or choose another --out");
+  };
   const std::lock_guard<std::mutex> guard(g_held_mutex);
   if (HeldLock& held = g_held[key_]; held.count > 0) {
     if (held.owner != std::this_thread::get_id()) {
-      throw InputError(out_dir.string() + ": another gtrack track run is writing there (pid " +
-                       std::to_string(::getpid()) + ", this process, another thread); wait for it to end, or "
-                       "choose another --out");
+      throw busy(" (pid " + std::to_string(::getpid()) + ", this process, another thread)");
     }
     ++held.count;
     return;
@@ -367,9 +370,7 @@ OutputLock::OutputLock(const fs::path& out_dir) {
     const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
     ::close(fd);
     g_held.erase(key_);
-    const std::string who = n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : "";
-    throw InputError(out_dir.string() + ": another gtrack track run is writing there" + who +
-                     "; wait for it to end, or choose another --out");
+    throw busy(n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : "");
   }
   if (locked != 0) {
     // A file system without locks (some network mounts): nothing to say

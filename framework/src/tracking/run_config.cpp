@@ -134,6 +134,13 @@ std::vector<std::string> file_header_lines(const fs::path& file) {
   return header_lines(std::string_view(text));
 }
 
+// The files a run's copy lists: those the config names, then `used`.
+std::vector<NamedFile> listed_files(const ConfigTable& root, const std::vector<NamedFile>& used) {
+  std::vector<NamedFile> files = root.named_files();
+  files.insert(files.end(), used.begin(), used.end());
+  return files;
+}
+
 struct KeptFile {
   std::string key, path, fingerprint;
 };
@@ -204,9 +211,7 @@ void write_run_config(const fs::path& file, const ConfigTable& root, bool durabl
   }
   std::string header = std::string(kFirstLine) + std::string(kFromMark) + from + "\n";
   header += std::string(kBaseLine) + encoded(base) + "\n";
-  std::vector<NamedFile> files = root.named_files();
-  files.insert(files.end(), used.begin(), used.end());
-  for (const NamedFile& f : files) {
+  for (const NamedFile& f : listed_files(root, used)) {
     header += std::string(kFileLine) + f.name() + " = " + encoded(f.path) + ": " + fingerprint(f.path) + "\n";
   }
   header += std::string(kPrefix) + "--resume checks that this config, and the files listed, are unchanged\n";
@@ -235,8 +240,7 @@ void check_same_config(const fs::path& file, const ConfigTable& root, const std:
                      "; cannot resume with another config (give the config the run was started with, which this "
                      "file copies and names, or another --out)");
   }
-  std::vector<NamedFile> current = root.named_files();
-  current.insert(current.end(), used.begin(), used.end());
+  const std::vector<NamedFile> current = listed_files(root, used);
   for (const KeptFile& kept : kept_files(file)) {
     const auto it = std::find_if(current.begin(), current.end(), [&](const NamedFile& f) { return f.name() == kept.key; });
     if (it == current.end()) continue;

@@ -14,6 +14,7 @@
 //   reading_min, reading_max: the readings taken (unbounded by default); a
 //     reading outside is refused, as a log in another unit would be;
 //   label, unit: how the overlay names the reading ("s", "").
+#include <cmath>
 #include <gtrack/hysteresis_stimulus.hpp>
 #include <gtrack/plugin.hpp>
 #include <string>
