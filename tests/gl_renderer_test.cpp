@@ -663,6 +663,36 @@ TEST(GlRenderer, ARendererUsedOnAnotherThreadMayBeDestroyedOnAThird) {
   }
 }
 
+// A thread that used a renderer and ended lets its context go: another
+// thread uses the renderer and destroys it, without a warning.
+TEST(GlRenderer, ARendererUsedOnAThreadThatEndedWorksOnAnother) {
+  const ArticulatedModel model(hydrogel_geometry());
+  const Eigen::MatrixXd H = camera_hypotheses(40, 29, model.fingers());
+  std::ostringstream log;
+  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  struct PopSink {
+    ~PopSink() { gtrack::logger().sinks().pop_back(); }
+  } pop_sink;
+  GL_OR_SKIP(gl);
+  std::vector<PairCounts> there, here;
+  std::string error;
+  std::thread([&] {
+    try {
+      gl->set_model(model);
+      gl->set_projection(camera(), kScale);
+      gl->evaluate(H, there);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }).join();
+  ASSERT_EQ(error, "");
+  gl->evaluate(H, here);  // threw EGL_BAD_ACCESS while the ended thread held the context
+  ASSERT_EQ(here.size(), there.size());
+  for (size_t i = 0; i < here.size(); ++i) EXPECT_EQ(here[i].rendered, there[i].rendered) << "hypothesis " << i;
+  gl.reset();
+  EXPECT_EQ(log.str().find("[warning]"), std::string::npos) << log.str();
+}
+
 TEST(GlRenderer, ReusesItsObjectsWhenSizesChange) {
   GL_OR_SKIP(gl);
   const ArticulatedModel model(hydrogel_geometry());

@@ -42,7 +42,7 @@ struct RenderOptions {
   // and folds reach more pixels (docs/tracker.md, "Render scale and the
   // rim's width").
   double scale = 0.5;
-  int threads = 0;               // cpu backend worker threads; 0 = hardware concurrency
+  int threads = 0;               // cpu backend worker threads, and llvmpipe's for gl; 0 = hardware concurrency
   std::string egl_device;        // gl: device index or "surfaceless"; "" = GTRACK_EGL_DEVICE or auto
 };
 

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
-#include <thread>
 #include <utility>
 
 #include "gtrack/error.hpp"
@@ -29,10 +28,24 @@ bool user_sets_lp_threads() {
   return set;
 }
 
+// Set only for a count asked for (0, every core, is llvmpipe's own
+// default), before the display is initialised: the environment is not
+// written while other threads may read it.
 void set_software_threads(int threads) {
-  if (user_sets_lp_threads()) return;
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (user_sets_lp_threads() || threads <= 0) return;
   setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+}
+
+// A context current on a thread stays bound to it after the thread ends
+// (Mesa does not let it go): no other thread could take it again, nor
+// delete the renderer's objects. A thread that makes a context current
+// releases its EGL state when it ends.
+void release_at_thread_exit() {
+  struct Release {
+    ~Release() { eglReleaseThread(); }
+  };
+  thread_local Release release;
+  (void)release;
 }
 
 std::string lowercase(std::string s) {
@@ -103,6 +116,7 @@ EglContext EglContext::try_open(const std::vector<DisplayCandidate>& candidates,
       release_display(display);
       continue;
     }
+    release_at_thread_exit();
     EglContext out;
     out.display_ = display;
     out.context_ = context;
@@ -121,10 +135,16 @@ EglContext EglContext::try_open(const std::vector<DisplayCandidate>& candidates,
 
 EglContext EglContext::open(const ContextRequest& request) {
   const std::string wanted = effective_device_request(request.device);
-  const std::vector<DisplayCandidate> devices = list_devices();
+  std::string no_devices;
+  const std::vector<DisplayCandidate> devices = list_devices(&no_devices);
 
   std::vector<DisplayCandidate> order;
   if (wanted.empty()) {
+    // A GPU left unused is refused rather than worked around on the CPU
+    // a hundred times slower; asking for "surfaceless" takes that choice.
+    if (const std::string missing = nvidia_without_egl(devices); !missing.empty()) {
+      throw Error("gl backend: " + missing + " (egl_device = \"surfaceless\" renders on the CPU through Mesa)");
+    }
     // A GPU first (NVIDIA's, then any other), then Mesa's surfaceless
     // platform (llvmpipe), then a software EGL device.
     for (DisplayKind kind : {DisplayKind::nvidia, DisplayKind::hardware}) {
@@ -158,7 +178,7 @@ EglContext EglContext::open(const ContextRequest& request) {
       std::string list;
       for (const auto& d : devices) list += (list.empty() ? "" : ", ") + d.label;
       throw Error("gl backend: EGL device " + wanted + " does not exist; devices: " +
-                  (list.empty() ? std::string("none") : list));
+                  (list.empty() ? "none: " + no_devices : list));
     }
     order.push_back(devices[static_cast<size_t>(index)]);
   }
@@ -215,9 +235,10 @@ void EglContext::make_current() const {
     const EGLint e = eglGetError();
     throw Error("gl backend: eglMakeCurrent failed with " + egl_error_name(e) +
                 (e == EGL_BAD_ACCESS ? std::string(" (its context is current on another thread: a gl renderer is "
-                                                   "used from the first thread that uses it only)")
+                                                   "used by one thread at a time, until that thread ends)")
                                      : std::string()));
   }
+  release_at_thread_exit();
 }
 
 void EglContext::release_current() const noexcept {
@@ -226,10 +247,12 @@ void EglContext::release_current() const noexcept {
   if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
-bool EglContext::software() const {
-  const std::string r = lowercase(renderer_);
+bool software_renderer(const std::string& gl_renderer) {
+  const std::string r = lowercase(gl_renderer);
   return r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos ||
-         r.find("swrast") != std::string::npos;
+         r.find("swrast") != std::string::npos || r.find("swiftshader") != std::string::npos;
 }
+
+bool EglContext::software() const { return software_renderer(renderer_); }
 
 }  // namespace gtrack::gl

@@ -28,7 +28,7 @@ struct ContextRequest {
   // a device index ("0", "1", ...); or "surfaceless".
   std::string device;
   // llvmpipe's LP_NUM_THREADS for a software display, unless the user's
-  // environment sets it; 0 = all hardware threads. llvmpipe reads it when a
+  // environment sets it; 0 = llvmpipe's own default (every core), left unset. llvmpipe reads it when a
   // display is initialised, so it only applies to the first context on it.
   int software_threads = 0;
 };
@@ -63,7 +63,7 @@ class EglContext {
   const std::string& display_label() const { return label_; }
   const std::string& gl_renderer() const { return renderer_; }
   const std::string& gl_version() const { return version_; }
-  // llvmpipe, softpipe or swrast: rendering runs on the CPU.
+  // software_renderer() of its GL_RENDERER: rendering runs on the CPU.
   bool software() const;
 
  private:
@@ -75,6 +75,10 @@ class EglContext {
   std::string renderer_;
   std::string version_;
 };
+
+// Whether a GL_RENDERER string names a renderer that runs on the CPU
+// (llvmpipe, softpipe, swrast, SwiftShader).
+bool software_renderer(const std::string& gl_renderer);
 
 // The device request in force: `explicit_request` if not empty, else
 // GTRACK_EGL_DEVICE, else "".

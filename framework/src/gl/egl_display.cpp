@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <mutex>
 
@@ -65,20 +66,28 @@ std::string egl_error_name(EGLint code) {
   }
 }
 
-std::vector<DisplayCandidate> list_devices() {
+std::vector<DisplayCandidate> list_devices(std::string* why) {
   std::vector<DisplayCandidate> out;
+  const auto none = [&](const char* reason) {
+    if (why) *why = reason;
+    return out;
+  };
   const char* client = client_extensions();
-  if (!has_word(client, "EGL_EXT_device_enumeration") && !has_word(client, "EGL_EXT_device_base")) return out;
-  if (!has_word(client, "EGL_EXT_platform_device")) return out;
+  if (!has_word(client, "EGL_EXT_device_enumeration") && !has_word(client, "EGL_EXT_device_base")) {
+    return none("the EGL library offers no EGL_EXT_device_enumeration (is an EGL vendor library installed?)");
+  }
+  if (!has_word(client, "EGL_EXT_platform_device")) return none("the EGL library offers no EGL_EXT_platform_device");
   auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
   auto query_string =
       reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
-  if (query_devices == nullptr) return out;
+  if (query_devices == nullptr) return none("the EGL library has no eglQueryDevicesEXT");
 
   EGLint count = 0;
-  if (!query_devices(0, nullptr, &count) || count <= 0) return out;
+  if (!query_devices(0, nullptr, &count) || count <= 0) {
+    return none("EGL enumerates no device (is an EGL vendor library installed?)");
+  }
   std::vector<EGLDeviceEXT> devices(static_cast<size_t>(count));
-  if (!query_devices(count, devices.data(), &count)) return out;
+  if (!query_devices(count, devices.data(), &count)) return none("eglQueryDevicesEXT failed");
   devices.resize(static_cast<size_t>(count));
 
   for (size_t i = 0; i < devices.size(); ++i) {
@@ -104,6 +113,22 @@ std::vector<DisplayCandidate> list_devices() {
     out.push_back(std::move(c));
   }
   return out;
+}
+
+std::string nvidia_without_egl(const std::vector<DisplayCandidate>& devices) {
+  for (const auto& d : devices) {
+    if (d.kind == DisplayKind::nvidia) return "";
+  }
+  std::error_code ec;
+  for (const char* file : {"/proc/driver/nvidia/version", "/dev/nvidiactl"}) {
+    if (std::filesystem::exists(file, ec)) {
+      return std::string("an NVIDIA driver is loaded (") + file +
+             ") but EGL lists no NVIDIA device: NVIDIA's EGL vendor library (libEGL_nvidia.so.0 and "
+             "/usr/share/glvnd/egl_vendor.d/10_nvidia.json) is missing or not visible; in a container, "
+             "NVIDIA_DRIVER_CAPABILITIES must include graphics";
+    }
+  }
+  return "";
 }
 
 bool surfaceless_available() { return has_word(client_extensions(), "EGL_MESA_platform_surfaceless"); }

@@ -40,9 +40,7 @@ int count_rows_for(const std::string& renderer) {
     }
     return static_cast<int>(v);
   }
-  const bool cpu = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos ||
-                   renderer.find("SwiftShader") != std::string::npos;
-  return cpu ? kMaxCountRows : 32;
+  return software_renderer(renderer) ? kMaxCountRows : 32;
 }
 
 // The render target's memory budget, in MiB. A batch that needs more layers
@@ -89,9 +87,8 @@ void delete_buffer(const Api& gl, GLuint& b) {
   b = 0;
 }
 
-std::string prelude(const std::string& layer_extension, int count_rows) {
+std::string prelude(int count_rows) {
   std::string p = "#version 450 core\n";
-  if (!layer_extension.empty()) p += "#extension " + layer_extension + " : require\n";
   p += "#define MAX_CLIP_PLANES " + std::to_string(kMaxClipPlanes) + "\n";
   p += "#define COUNT_GROUP_WIDTH " + std::to_string(kCountGroupWidth) + "\n";
   p += "#define COUNT_ROWS " + std::to_string(count_rows) + "\n";
@@ -137,11 +134,15 @@ GlRenderer::GlRenderer(const RenderOptions& options)
   GLint max_layers = 0;
   gl_.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   max_layers_ = std::max(1, static_cast<int>(max_layers));
-  const std::string head = prelude(layer_extension, count_rows_);
-  draw_program_ = build_program(gl_, head, {{GL_VERTEX_SHADER, {"pose.glsl", "hypotheses.vert"}},
-                                            {GL_FRAGMENT_SHADER, {"hypotheses.frag"}}});
+  const std::string head = prelude(count_rows_);
+  // The layer extension is the vertex stage's alone: a strict compiler
+  // refuses it in other stages.
+  draw_program_ = build_program(gl_, head,
+                                {{GL_VERTEX_SHADER, {"pose.glsl", "hypotheses.vert"},
+                                  "#extension " + layer_extension + " : require\n"},
+                                 {GL_FRAGMENT_SHADER, {"hypotheses.frag"}, ""}});
   try {
-    count_program_ = build_program(gl_, head, {{GL_COMPUTE_SHADER, {"count.comp"}}});
+    count_program_ = build_program(gl_, head, {{GL_COMPUTE_SHADER, {"count.comp"}, ""}});
   } catch (...) {
     gl_.DeleteProgram(draw_program_);
     throw;

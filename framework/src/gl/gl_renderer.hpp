@@ -12,11 +12,12 @@
 // until they change.
 //
 // Threads: the constructor leaves the context current on no thread; the first
-// thread that calls the renderer makes it current and keeps it, and is the
-// only one that may use the renderer from then on (another gets
-// EGL_BAD_ACCESS). Destroyed on another thread, the renderer cannot delete its
-// objects (a warning says so): they are freed with the context once the thread
-// that used it makes it current no more.
+// thread that calls the renderer makes it current and keeps it until it ends
+// (its EGL state is then released), and is the only one that may use the
+// renderer meanwhile (another gets EGL_BAD_ACCESS). Destroyed on another
+// thread while that one runs, the renderer cannot delete its objects (a
+// warning says so): they are freed with the context once the thread that
+// used it makes it current no more, or ends.
 #pragma once
 
 #include <cstdint>

@@ -2,6 +2,7 @@
 #include <mutex>
 
 #include "gl/egl_context.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/renderer.hpp"
 
 namespace gtrack {
@@ -11,8 +12,12 @@ namespace {
 bool probe() {
   // Software devices are never worth a context: only hardware ones are tried,
   // so on a machine without a GPU this is one device enumeration.
+  const std::vector<gl::DisplayCandidate> devices = gl::list_devices();
+  if (const std::string missing = gl::nvidia_without_egl(devices); !missing.empty()) {
+    logger().warn("render backend auto: {}; rendering on the cpu backend", missing);
+  }
   std::vector<gl::DisplayCandidate> hardware;
-  for (const auto& d : gl::list_devices()) {
+  for (const auto& d : devices) {
     if (d.kind == gl::DisplayKind::nvidia || d.kind == gl::DisplayKind::hardware) hardware.push_back(d);
   }
   for (const auto& d : hardware) {

@@ -126,7 +126,8 @@ GLuint build_program(const Api& gl, const std::string& prelude, const std::vecto
       stage_files += (stage_files.empty() ? "" : ", ") + files[i].path.string();
     }
     all_files += (all_files.empty() ? "" : ", ") + stage_files;
-    std::vector<const GLchar*> strings{prelude.c_str()};
+    const std::string stage_prelude = prelude + stage.prelude;
+    std::vector<const GLchar*> strings{stage_prelude.c_str()};
     for (const std::string& t : texts) strings.push_back(t.c_str());
 
     const GLuint shader = gl.CreateShader(stage.type);

@@ -22,6 +22,7 @@ namespace gtrack::gl {
 struct ShaderStage {
   GLenum type = 0;                 // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER
   std::vector<std::string> files;  // names inside the shader folder, in order
+  std::string prelude;             // lines for this stage only, after the program's prelude (#extension ...)
 };
 
 // The folders searched for shader files, in order.
