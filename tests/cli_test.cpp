@@ -16,6 +16,8 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "gtrack/model.hpp"
 
@@ -250,6 +252,49 @@ TEST(Cli, TrackRefusesAReadingTheStimulusPluginCannotTake) {
                           "0.000 s); expected seconds from the recording's first frame"),
             std::string::npos)
       << r.output;
+}
+
+// A log on another clock by minutes (a logger started before the camera)
+// covers none of the frames: refused, where every frame would have taken
+// its first row's reading. One whose readings' column names another unit
+// than the stimulus plugin reads is refused too; the same unit, or a name
+// that says none, passes. A time_s log beside a folder of images, which
+// has no frame rate, says the rate taken.
+TEST(Cli, TrackRefusesALogOnAnotherClockOrInAnotherUnit) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "log_clock_unit";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 3 --out " + dir.string()).code, 0);
+  const auto track_with = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return gtrack(track_of(dir) + " -s " + (dir / name).string() + " -o " + (dir / "out").string() +
+                  " --no-overlay --log-level warn");
+  };
+  const CliRun late = track_with("late.csv", "time_s,T_C\n120.0,22\n121.0,23\n");
+  EXPECT_EQ(late.code, 1) << late.output;
+  EXPECT_NE(late.output.find("late.csv: its rows cover t = 120.000 to 121.000 s, the frames to track t = 0.000 to "
+                             "0.067 s: none of them falls within the log"),
+            std::string::npos)
+      << late.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));
+  const CliRun fahrenheit = track_with("f.csv", "time_s,T_F\n0.0,71.6\n1.0,72\n");
+  EXPECT_EQ(fahrenheit.code, 1) << fahrenheit.output;
+  EXPECT_NE(fahrenheit.output.find("f.csv: its readings' column 'T_F' says F, but the stimulus plugin "
+                                   "'temperature_hysteresis' reads C"),
+            std::string::npos)
+      << fahrenheit.output;
+  for (const std::string& header : {"time_s,T_C", "time_s,temperature (degC)", "time_s,value"}) {
+    const CliRun ok = track_with("ok.csv", header + "\n0.0,22\n1.0,23\n");
+    EXPECT_EQ(ok.code, 0) << header << ": " << ok.output;
+    EXPECT_EQ(ok.output.find("no frame rate"), std::string::npos) << "sequence.toml sets fps: " << ok.output;
+  }
+  std::ofstream(dir / "no_fps.toml") << replaced(read_file(dir / "sequence.toml"), "\nfps = 30.0\n", "\n");
+  const CliRun no_fps = gtrack("track -c " + (dir / "no_fps.toml").string() + " -i " + (dir / "frames").string() +
+                               " -s " + (dir / "ok.csv").string() + " -o " + (dir / "out").string() +
+                               " --no-overlay --log-level warn");
+  EXPECT_EQ(no_fps.code, 0) << no_fps.output;
+  EXPECT_NE(no_fps.output.find("the images carry no frame rate, so 30 frames/s is taken for the time_s log"),
+            std::string::npos)
+      << no_fps.output;
 }
 
 // --restart-from TABLE: each frame is tracked from the table's row for the
@@ -1038,6 +1083,57 @@ TEST(Cli, EveryProgressLineReachesStderrWhileFramesAreDecoded) {
     EXPECT_NE(r.output.find(line), std::string::npos) << line << " missing from:\n" << r.output;
   }
   fs::remove_all(dir);
+}
+
+// What passes the bounds besides the gripper. A bar of the gripper's colour,
+// larger than it, across the bottom of the frames (a dish's rim, a tank's
+// wall): the coarse search also tries each large blob, and the track starts
+// on the gripper, not the bar. The same frames strewn with gripper-coloured
+// specks: every frame is "ok", and a warning says that the model fits what
+// is observed poorly.
+TEST(Cli, TrackFindsTheGripperBesideALargerBlobAndSaysWhenTheFitIsPoor) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "clutter";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 12 --seed 3 --out " + dir.string()).code, 0);
+  const cv::Scalar colour(121, 171, 205);  // the microscope preset's gripper (HSV 18, 105, 205)
+  cv::RNG rng(5);
+  fs::create_directories(dir / "bar");
+  fs::create_directories(dir / "specks");
+  for (const auto& entry : fs::directory_iterator(dir / "frames")) {
+    const cv::Mat frame = cv::imread(entry.path().string());
+    ASSERT_FALSE(frame.empty());
+    cv::Mat bar = frame.clone();
+    cv::rectangle(bar, cv::Rect(10, 940, 1004, 70), colour, cv::FILLED);  // 70k pixels; the gripper shows < 60k
+    cv::imwrite((dir / "bar" / entry.path().filename()).string(), bar);
+    cv::Mat specks = frame.clone();
+    for (int y = 0; y + 4 <= specks.rows; y += 4) {
+      for (int x = 0; x + 4 <= specks.cols; x += 4) {
+        if (rng.uniform(0.0, 1.0) < 0.3) cv::rectangle(specks, cv::Rect(x, y, 4, 4), colour, cv::FILLED);
+      }
+    }
+    cv::imwrite((dir / "specks" / entry.path().filename()).string(), specks);
+  }
+  const CliRun bar = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "bar").string() +
+                            " -o " + (dir / "out_bar").string() + " --frames 0:3 --no-overlay --log-level warn");
+  ASSERT_EQ(bar.code, 0) << bar.output;
+  const auto truth = read_csv(dir / "ground_truth.csv");
+  const auto estimates = read_csv(dir / "out_bar" / "estimates.csv");
+  ASSERT_GE(estimates.size(), 4u);
+  for (size_t row = 1; row < 4; ++row) {
+    const double dx = std::stod(estimates[row][1]) - std::stod(truth[row][1]);
+    const double dy = std::stod(estimates[row][2]) - std::stod(truth[row][2]);
+    EXPECT_LT(std::hypot(dx, dy), 0.2) << "frame " << row - 1 << " (mm in the image plane)";
+  }
+  const std::string poor = "the model fits what is observed poorly";
+  EXPECT_EQ(bar.output.find(poor), std::string::npos) << bar.output;
+  const CliRun specks = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " +
+                               (dir / "specks").string() + " -o " + (dir / "out_specks").string() +
+                               " --no-overlay --log-level warn");
+  ASSERT_EQ(specks.code, 0) << specks.output;
+  EXPECT_NE(specks.output.find("frames 0 to 9: " + poor), std::string::npos) << specks.output;
+  const CliRun clean = gtrack(track_of(dir) + " -o " + (dir / "out_clean").string() + " --no-overlay --log-level warn");
+  ASSERT_EQ(clean.code, 0) << clean.output;
+  EXPECT_EQ(clean.output.find(poor), std::string::npos) << clean.output;
 }
 
 }  // namespace

@@ -301,11 +301,26 @@ TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
     std::snprintf(name, sizeof name, "%06d.png", i);
     cv::imwrite((dir / "grey" / name).string(), grey);
   }
-  const std::string said = "a grey image, but [observation] color_space = \"hsv\" with saturation_min";
+  const std::string said = "a grey image (its channels within 0 levels of each other), but [observation] "
+                           "color_space = \"hsv\" with saturation_min";
   const std::string grey_log = warnings_of(dir / "grey", dir / "out_grey");
   EXPECT_NE(grey_log.find("000000.png: " + said), std::string::npos) << grey_log;
   EXPECT_EQ(grey_log.find(said), grey_log.rfind(said)) << "said once: " << grey_log;
-  EXPECT_EQ(warnings_of(colour, dir / "out_colour").find(said), std::string::npos);
+  EXPECT_EQ(warnings_of(colour, dir / "out_colour").find("a grey image"), std::string::npos);
+  // A grey video decoded from 4:2:0 chroma: channels a level or two apart.
+  fs::create_directories(dir / "near_grey");
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat grey, bgr;
+    cv::cvtColor(frame_image(i), grey, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+    bgr.forEach<cv::Vec3b>([](cv::Vec3b& p, const int* at) { p[0] = cv::saturate_cast<uchar>(p[0] + (at[1] % 3)); });
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    cv::imwrite((dir / "near_grey" / name).string(), bgr);
+  }
+  const std::string near_log = warnings_of(dir / "near_grey", dir / "out_near_grey");
+  EXPECT_NE(near_log.find("000000.png: a grey image (its channels within 2 levels of each other)"), std::string::npos)
+      << near_log;
   // One grey image among colour ones is said at that image.
   cv::Mat grey;
   cv::cvtColor(frame_image(1), grey, cv::COLOR_BGR2GRAY);
@@ -353,6 +368,15 @@ TEST(Fault, WhatTheObservationMakesOfTheRecordingIsSaidOnce) {
             std::string::npos)
       << bright_log;
   EXPECT_NE(bright_log.find("needs luminance_min = 0"), std::string::npos) << bright_log;
+  // Bounds for a dark gripper that take in the background: luminance_max is
+  // the bound to move.
+  r.config.observation.luminance_min = 0;
+  r.config.observation.luminance_max = 250;
+  const std::string dark_log = warnings_of(dir / "bright_field", dir / "out_dark_bounds");
+  EXPECT_NE(dark_log.find("lower luminance_max below the background's darkest brightness"), std::string::npos)
+      << dark_log;
+  r.config.observation.luminance_min = 128;
+  r.config.observation.luminance_max = 255;
   EXPECT_EQ(warnings_of(plain, dir / "out_dark_field").find("is within the [observation] bounds"), std::string::npos);
 }
 

@@ -65,6 +65,9 @@ class GTRACK_API StimulusLog {
   double first_key() const { return keys_.front(); }
   double last_key() const { return keys_.back(); }
   const std::string& source() const { return source_; }
+  // The readings' column as the header names it ("value", "B_mT"); empty
+  // before a followed log's header is read.
+  const std::string& value_name() const { return value_name_; }
 
  private:
   void take_line(std::string line);

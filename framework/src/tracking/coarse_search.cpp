@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <utility>
@@ -19,6 +20,11 @@ namespace {
 
 constexpr double kBackwardFoldDeg = 10.0;
 constexpr double kBorderStepRadii = 0.3;  // the coarse grid's step out across a border
+// O's blobs the coarse grid is also placed on, the largest first, each of at
+// least this share of the area of a disc of the model's radius (a gripper
+// mostly hidden shows little).
+constexpr int kBlobsTried = 3;
+constexpr double kBlobShare = 0.05;
 
 struct OutlineScratch {
   std::vector<Eigen::Vector3d> vertices;
@@ -116,17 +122,23 @@ Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen:
   return near + a.transpose() * aat.ldlt().solve(r);
 }
 
-// The centroid (pixel centres at +0.5) of the largest 8-connected blob of a
-// mask that holds more than one; nullopt for one blob or none.
-std::optional<Eigen::Vector2d> largest_blob_centre(const cv::Mat& mask) {
+// The centroids (pixel centres at +0.5) of a mask's 8-connected blobs, the
+// largest first: at most `most`, each of `min_area` pixels or more; none for
+// a mask of one blob or none.
+std::vector<Eigen::Vector2d> blob_centres(const cv::Mat& mask, int most, double min_area) {
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  if (n <= 2) return std::nullopt;  // the background and at most one blob
-  int best = 1;
-  for (int i = 2; i < n; ++i) {
-    if (stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = i;
+  if (n <= 2) return {};  // the background and at most one blob
+  std::vector<int> order(static_cast<size_t>(n - 1));
+  std::iota(order.begin(), order.end(), 1);
+  const auto area = [&](int i) { return stats.at<int>(i, cv::CC_STAT_AREA); };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return area(a) > area(b); });
+  std::vector<Eigen::Vector2d> centres;
+  for (int i : order) {
+    if (static_cast<int>(centres.size()) == most || area(i) < min_area) break;
+    centres.emplace_back(centroids.at<double>(i, 0) + 0.5, centroids.at<double>(i, 1) + 0.5);
   }
-  return Eigen::Vector2d(centroids.at<double>(best, 0) + 0.5, centroids.at<double>(best, 1) + 0.5);
+  return centres;
 }
 
 CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig& config, CostEvaluator& cost,
@@ -264,24 +276,29 @@ CoarseSearchResult coarse_search(const CoarseSearchInput& in, const EngineConfig
 
     return std::make_pair(std::move(grid), std::move(scores));
   };
-  // Around the centroid of O; and, when O holds apart a blob of its own
-  // (the gripper beside a bright reflector, a caliper mark or clutter that
-  // passes the bounds), around the largest blob too: the centroid of all
-  // of them can lie on none.
+  // Around the centroid of O; and, when O holds blobs apart (the gripper
+  // beside a bright reflector, a caliper mark or clutter that passes the
+  // bounds), around its largest blobs too, each farther than the model's
+  // radius from every place tried: the centroid of all of them can lie on
+  // none, and the gripper need not be the largest (a tank's wall, a dish's
+  // rim).
   const double u = observed ? mo.m10 / mo.m00 + 0.5 : in.observation->cols * 0.5;
   const double v = observed ? mo.m01 / mo.m00 + 0.5 : in.observation->rows * 0.5;
   auto [grid, scores] = grid_at(u, v);
-  if (const auto blob = largest_blob_centre(*in.observation)) {
-    if ((*blob - Eigen::Vector2d(u, v)).norm() > radius_px_at(lift_pixel(in.render_projection, u, v, in.nominal_mm))) {
-      logger().debug("coarse search: also from O's largest blob, at ({:.0f}, {:.0f}) render pixels, {:.0f} from O's "
-                     "centroid",
-                     blob->x(), blob->y(), (*blob - Eigen::Vector2d(u, v)).norm());
-      auto [more, more_scores] = grid_at(blob->x(), blob->y());
-      grid.conservativeResize(Eigen::NoChange, grid.cols() + more.cols());
-      grid.rightCols(more.cols()) = more;
-      scores.conservativeResize(scores.size() + more_scores.size());
-      scores.tail(more_scores.size()) = more_scores;
+  const double apart = radius_px_at(lift_pixel(in.render_projection, u, v, in.nominal_mm));
+  std::vector<Eigen::Vector2d> tried{Eigen::Vector2d(u, v)};
+  for (const Eigen::Vector2d& blob : blob_centres(*in.observation, kBlobsTried, kBlobShare * std::numbers::pi * apart * apart)) {
+    if (std::any_of(tried.begin(), tried.end(), [&](const Eigen::Vector2d& t) { return (blob - t).norm() <= apart; })) {
+      continue;
     }
+    logger().debug("coarse search: also from a blob of O at ({:.0f}, {:.0f}) render pixels, {:.0f} from O's centroid",
+                   blob.x(), blob.y(), (blob - tried.front()).norm());
+    tried.push_back(blob);
+    auto [more, more_scores] = grid_at(blob.x(), blob.y());
+    grid.conservativeResize(Eigen::NoChange, grid.cols() + more.cols());
+    grid.rightCols(more.cols()) = more;
+    scores.conservativeResize(scores.size() + more_scores.size());
+    scores.tail(more_scores.size()) = more_scores;
   }
 
   std::vector<int> order(static_cast<size_t>(grid.cols()));

@@ -1,10 +1,12 @@
 // `gtrack track` as a library call: source -> Tracker -> files.
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -168,6 +170,86 @@ int expected_frames(const FrameSource& src, const FrameRange& r) {
   return (n - r.first + r.every - 1) / r.every;
 }
 
+// A time_s log whose times start more than a day after a frame's: seconds
+// since 1970 (Unix time), say.
+std::string another_clock(const StimulusLog& log, int frame, double time_s) {
+  return fmt::format(
+      "{}: its times start at t = {:.3f} s, more than a day after frame {} (t = {:.3f} s); expected seconds "
+      "from the recording's first frame (a log in Unix time needs its first frame's time subtracted)",
+      log.source(), log.first_key(), frame, time_s);
+}
+
+// A finished stimulus log against the frames to track: one that covers none
+// of them is on another clock (a logger started before the camera), and
+// every frame would take its nearest end's reading; a time_s log with a
+// folder of images or a TIFF stack, which have no frame rate of their own,
+// runs on the 30 frames/s taken for them unless [tracker] fps says
+// otherwise.
+void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options, const FrameRange& range,
+                             int expected, double fps, double config_fps) {
+  const bool by_time = log.key() == StimulusLog::Key::Time;
+  std::error_code ec;
+  std::string extension = fs::path(options.input).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool images = fs::is_directory(options.input, ec) || extension == ".tif" || extension == ".tiff";
+  if (by_time && images && config_fps <= 0) {
+    logger().warn("{}: the images carry no frame rate, so {:g} frames/s is taken for the time_s log {} and the "
+                  "material's response; if the camera ran at another rate, set [tracker] fps",
+                  options.input, fps, log.source());
+  }
+  if (expected <= 0) return;  // a camera or a followed folder: the frames to come are not known
+  const int first = range.first, last = range.first + (expected - 1) * std::max(1, range.every);
+  const double slack = by_time ? 0.5 / fps : 0.5;
+  const double from = by_time ? first / fps : first, to = by_time ? last / fps : last;
+  if (by_time && log.first_key() > from + 86400) throw InputError(another_clock(log, first, from));
+  if (to < log.first_key() - slack || from > log.last_key() + slack) {
+    const char* unit = by_time ? "t = " : "frame ";
+    const char* suffix = by_time ? " s" : "";
+    const int digits = by_time ? 3 : 0;
+    throw InputError(fmt::format(
+        "{}: its rows cover {}{:.{}f} to {:.{}f}{}, the frames to track {}{:.{}f} to {:.{}f}{}: none of them falls "
+        "within the log; expected {} from the recording's first frame (a log started before the recording needs "
+        "that offset subtracted from its {} column)",
+        log.source(), unit, log.first_key(), digits, log.last_key(), digits, suffix, unit, from, digits, to, digits,
+        suffix, by_time ? "seconds" : "frame numbers", by_time ? "time_s" : "frame"));
+  }
+}
+
+// The unit a log's column name ends with ("T_F", "B_mT", "temp (degC)"),
+// in one spelling per unit; "" for a name that says none the check knows.
+std::string unit_in_name(const std::string& name) {
+  std::string token;
+  if (const size_t open = name.find_last_of("(["); open != std::string::npos && name.size() > open + 2 &&
+                                                   (name.back() == ')' || name.back() == ']')) {
+    token = name.substr(open + 1, name.size() - open - 2);
+  } else if (const size_t sep = name.find_last_of("_ "); sep != std::string::npos) {
+    token = name.substr(sep + 1);
+  }
+  for (char& c : token) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  static const std::pair<const char*, const char*> spellings[] = {
+      {"c", "C"},    {"degc", "C"},  {"\u00b0c", "C"}, {"celsius", "C"}, {"f", "F"}, {"degf", "F"},
+      {"\u00b0f", "F"}, {"fahrenheit", "F"}, {"k", "K"}, {"kelvin", "K"},  {"t", "T"}, {"tesla", "T"},
+      {"mt", "mT"},  {"ut", "uT"},   {"\u00b5t", "uT"}, {"g", "G"},       {"gauss", "G"}, {"mg", "mG"}};
+  for (const auto& [spelled, unit] : spellings) {
+    if (token == spelled) return unit;
+  }
+  return "";
+}
+
+// A log whose readings' column names its unit ("T_F") against a stimulus
+// that reads another ("C"): the readings would be taken in the wrong unit,
+// which their values alone cannot show (71 degrees Fahrenheit pass for a
+// warm Celsius reading).
+void check_log_unit(const StimulusLog& log, const Stimulus& stimulus, const std::string& plugin) {
+  const std::string in_log = unit_in_name(log.value_name());
+  const std::string read = unit_in_name("_" + stimulus.reading_unit());
+  if (in_log.empty() || read.empty() || in_log == read) return;
+  throw InputError(fmt::format("{}: its readings' column '{}' says {}, but the stimulus plugin '{}' reads {}; "
+                               "expected readings in {} (or, for a plugin that reads several units, [stimulus] set "
+                               "to the log's: temperature_hysteresis's log_unit)",
+                               log.source(), log.value_name(), in_log, plugin, read, read));
+}
+
 // A pose table (--restart-from, --score-truth) for the gripper of this setup.
 // `truth`: every cell must be finite (--score-truth); a track to restart
 // from may hold lost rows, which are refused where they would be used.
@@ -215,11 +297,14 @@ class ObservationAdvice {
                     "bounds ({}): they take the background for the gripper, and the track follows it; {} (check "
                     "with --save-masks)",
                     frame.name, 100 * share, times_model, bounds(),
-                    o_.color_space == "luminance"
-                        ? "raise luminance_min above the background's brightness (a dark gripper on a light "
-                          "background needs luminance_min = 0 and luminance_max below the background's)"
-                        : "narrow them to the gripper's colour");
+                    o_.color_space != "luminance" ? "narrow them to the gripper's colour"
+                    : o_.luminance_min <= 0
+                        ? "lower luminance_max below the background's darkest brightness, or leave its dark "
+                          "parts (a vignette's corners) out with exclude_px"
+                        : "raise luminance_min above the background's brightness (a dark gripper on a light "
+                          "background needs luminance_min = 0 and luminance_max below the background's)");
     }
+    poor_fit(frame, e);
   }
 
  private:
@@ -251,18 +336,64 @@ class ObservationAdvice {
   bool grey_for_colour(const Frame& frame, bool first) const {
     if (o_.color_space != "hsv" || !(o_.saturation_min > 0) || frame.image.channels() != 3) return false;
     if (uniform(frame.image)) return false;
+    // Grey within a few levels: a grey video decoded from 4:2:0 chroma
+    // (H.264, MPEG-4) has channels a level or two apart, enough to give its
+    // near-black pixels (a time stamp's text) a saturation above the bound.
     cv::Mat channels[3];
     cv::split(frame.image, channels);
-    if (cv::countNonZero(channels[0] != channels[1]) > 0 || cv::countNonZero(channels[1] != channels[2]) > 0) {
-      return false;
+    double most = 0;
+    for (int c : {1, 2}) {
+      cv::Mat diff;
+      cv::absdiff(channels[0], channels[c], diff);
+      double apart = 0;
+      cv::minMaxLoc(diff, nullptr, &apart);
+      most = std::max(most, apart);
     }
-    logger().warn("{}: a grey image, but [observation] color_space = \"hsv\" with saturation_min = {} finds "
-                  "nothing without colour; {} (for grey images use color_space = \"luminance\")",
-                  frame.name, o_.saturation_min,
-                  first ? "every frame will be lost" : "it is lost, and every grey image after it");
+    if (most > kGreyLevels) return false;
+    logger().warn("{}: a grey image (its channels within {} levels of each other), but [observation] color_space = "
+                  "\"hsv\" with saturation_min = {} needs colour: what passes it is noise, of dark pixels or of "
+                  "the compression; {} (for grey images use color_space = \"luminance\")",
+                  frame.name, most, o_.saturation_min,
+                  first ? "every frame will be lost or tracked on that noise"
+                        : "it is lost or tracked on noise, and every grey image after it");
     return true;
   }
 
+  // A track whose model fits what is observed poorly, frame after frame:
+  // the bounds take something else for the gripper (a reflector, the
+  // background, a scale bar), or the sensor's scale or the gripper's size
+  // is wrong, and the frames come out "ok" all the same. Said once, when
+  // the median D of kFitFrames consecutive tracked frames exceeds kPoorFit
+  // (a tracked gripper stays under about 0.2, under occluders too).
+  void poor_fit(const Frame& frame, const Estimate& e) {
+    if (said_fit_) return;
+    if (e.status == TrackStatus::Lost) {
+      fit_.clear();
+      return;
+    }
+    fit_.emplace_back(frame.index, e.terms.dice);
+    if (static_cast<int>(fit_.size()) < kFitFrames) return;
+    std::vector<double> d;
+    for (const auto& [index, dice] : fit_) d.push_back(dice);
+    std::nth_element(d.begin(), d.begin() + kFitFrames / 2, d.end());
+    const double median = d[kFitFrames / 2];
+    if (median > kPoorFit) {
+      said_fit_ = true;
+      logger().warn("frames {} to {}: the model fits what is observed poorly (D, 0 for a perfect fit and 1 for none, "
+                    "has a median of {:.2f} over them; a tracked gripper stays under about 0.2): the [observation] "
+                    "bounds may take something else for the gripper (a reflector, the background, text burned into "
+                    "the frames: exclude_px), or the sensor's scale or the gripper's size is wrong; check with "
+                    "--save-masks and the overlay video",
+                    fit_.front().first, frame.index, median);
+    }
+    fit_.pop_front();
+  }
+
+  static constexpr double kGreyLevels = 3;  // channels this far apart are grey
+  static constexpr int kFitFrames = 10;
+  static constexpr double kPoorFit = 0.35;
+  std::deque<std::pair<int, double>> fit_;  // frame, D: the last tracked frames
+  bool said_fit_ = false;
   const ObservationConfig& o_;
   bool said_grey_ = false, said_empty_ = false, seen_any_ = false;
 };
@@ -465,6 +596,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                      " frames, none of them in --frames " + std::to_string(range.first) + ":" +
                      (range.last >= 0 ? std::to_string(range.last) : std::string()));
   }
+  if (log && setup.stimulus) {
+    check_log_unit(*log, *setup.stimulus, setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "");
+  }
+  if (log && !options.follow_stimulus) check_log_covers_frames(*log, options, range, expected, fps, config.tracker.fps);
 
   // The reading of a frame: the log's, or its nearest past the log's ends.
   bool warned_range = false;
@@ -479,10 +614,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const bool by_time = log->key() == StimulusLog::Key::Time;
       if (by_time && log->first_key() > time_s + 86400) {
         // Another clock: seconds since 1970 (Unix time), say.
-        throw InputError(fmt::format(
-            "{}: its times start at t = {:.3f} s, more than a day after frame {} (t = {:.3f} s); expected seconds "
-            "from the recording's first frame (a log in Unix time needs its first frame's time subtracted)",
-            log->source(), log->first_key(), index, time_s));
+        throw InputError(another_clock(*log, index, time_s));
       }
       // A time written with few decimals (59 / 15 s as 3.9333) is the
       // frame's own row: within half a frame of the log's ends, no warning.
