@@ -50,6 +50,30 @@ TEST(FrameSource, AFolderIsReadInTheOrderOfTheNumbersInItsNames) {
                                                    "frame10.png@4", "frame100.png@5", "other.png@6"}));
 }
 
+// A file that is not a video says so in one line: an empty one as empty,
+// another with the decoder's words.
+TEST(FrameSource, AFileThatIsNoVideoIsNamedWithWhatItIs) {
+  const fs::path dir = folder_of("not_a_video", {});
+  std::ofstream(dir / "empty.mp4").close();
+  std::ofstream(dir / "text.mp4") << "not a video at all\n";
+  const auto message = [](const fs::path& file) {
+    try {
+      gtrack::open_frame_source(file.string(), {4, 4}, {}, 30);
+    } catch (const gtrack::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(dir / "empty.mp4"),
+            (dir / "empty.mp4").string() + ": an empty file (0 bytes); expected a video, a folder of images or a "
+                                           "TIFF stack");
+  EXPECT_EQ(message(dir / "text.mp4").rfind((dir / "text.mp4").string() + ": cannot open as a video (corrupt, "
+                                            "unsupported, or holding no frame",
+                                            0),
+            0u)
+      << message(dir / "text.mp4");
+}
+
 TEST(FrameSource, ARangeAndAStrideCountFromItsStart) {
   const fs::path dir = folder_of("range", {"000000.png", "000001.png", "000002.png", "000003.png", "000004.png"});
   gtrack::FrameRange r = gtrack::parse_frame_range("1:5");

@@ -890,7 +890,10 @@ std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expec
     said = library.take();
   }
   if (!opened) {
-    throw InputError(spec + ": cannot open as a video (corrupt or unsupported format" +
+    if (fs::is_regular_file(spec, ec) && fs::file_size(spec, ec) == 0) {
+      throw InputError(spec + ": an empty file (0 bytes); expected a video, a folder of images or a TIFF stack");
+    }
+    throw InputError(spec + ": cannot open as a video (corrupt, unsupported, or holding no frame" +
                      (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
   }
   if (!said.empty()) logger().debug("{}: the decoder said: {}", spec, said);
