@@ -1136,4 +1136,43 @@ TEST(Cli, TrackFindsTheGripperBesideALargerBlobAndSaysWhenTheFitIsPoor) {
   EXPECT_EQ(clean.output.find(poor), std::string::npos) << clean.output;
 }
 
+// gtrack segment: what the bounds take in whole frames, at full resolution.
+// On a synthetic frame, the gripper's visible part (the truth's `visible`
+// share of its outline); bounds of another colour, nothing. Masks and
+// previews are written per frame; the percentiles of the bounds' channels
+// are printed.
+TEST(Cli, SegmentShowsWhatTheBoundsTakeInWholeFrames) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "segment";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 3 --out " + dir.string()).code, 0);
+  const CliRun r = gtrack("segment -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                          " -o " + (dir / "seg").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* name : {"masks/000000.png", "masks/000001.png", "preview/000000.png", "preview/000001.png"}) {
+    EXPECT_TRUE(fs::exists(dir / "seg" / name)) << name;
+  }
+  const cv::Mat mask = cv::imread((dir / "seg" / "masks" / "000000.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(mask.type(), CV_8UC1);
+  EXPECT_EQ(mask.cols, 1024);
+  const std::string said = "frame 0: " + std::to_string(cv::countNonZero(mask)) + " pixels within the bounds";
+  EXPECT_NE(r.output.find(said), std::string::npos) << said << " in " << r.output;
+  const size_t at = r.output.find("the gripper face-on at the working distance covers about ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const double face_on = std::stod(r.output.substr(at + 57));
+  EXPECT_GT(cv::countNonZero(mask), 0.3 * face_on);
+  EXPECT_LT(cv::countNonZero(mask), 1.5 * face_on);
+  EXPECT_NE(r.output.find("saturation:  p1"), std::string::npos) << r.output;
+  std::ofstream(dir / "blue.toml") << read_file(dir / "sequence.toml") + "\n[observation]\nhue_min = 100\nhue_max = 130\n";
+  const CliRun blue = gtrack("segment -c " + (dir / "blue.toml").string() + " -i " + (dir / "frames").string() +
+                             " -o " + (dir / "seg_blue").string() + " --frames 0");
+  ASSERT_EQ(blue.code, 0) << blue.output;
+  EXPECT_NE(blue.output.find("frame 0: 0 pixels within the bounds"), std::string::npos) << blue.output;
+  EXPECT_EQ(blue.output.find("frame 1:"), std::string::npos) << blue.output;
+  std::ofstream(dir / "a_file") << "x";
+  const CliRun file = gtrack("segment -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                             " -o " + (dir / "a_file").string());
+  EXPECT_EQ(file.code, 1) << file.output;
+  EXPECT_NE(file.output.find("a_file: is a file; expected a folder (--out)"), std::string::npos) << file.output;
+}
+
 }  // namespace

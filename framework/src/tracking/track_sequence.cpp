@@ -286,7 +286,7 @@ class ObservationAdvice {
     if (!said_empty_ && !seen_any_ && e.observed_pixels == 0 && !said_grey_ && !uniform(frame.image)) {
       said_empty_ = true;
       logger().warn("{}: no pixel within the [observation] bounds ({}){}: the frame is lost, as every frame will be "
-                    "until the gripper shows; if it is in view, check the bounds on this recording with --save-masks",
+                    "until the gripper shows; if it is in view, check the bounds on this recording with gtrack segment",
                     frame.name, bounds(), excluded(frame.image.size()));
     }
     seen_any_ = seen_any_ || e.observed_pixels > 0;
@@ -295,7 +295,7 @@ class ObservationAdvice {
     if (first && (share > 0.5 || times_model > 10)) {
       logger().warn("{}: {:.0f} % of the image, {:.0f} times the gripper's outline, is within the [observation] "
                     "bounds ({}): they take the background for the gripper, and the track follows it; {} (check "
-                    "with --save-masks)",
+                    "with gtrack segment)",
                     frame.name, 100 * share, times_model, bounds(),
                     o_.color_space != "luminance" ? "narrow them to the gripper's colour"
                     : o_.luminance_min <= 0
@@ -383,7 +383,7 @@ class ObservationAdvice {
                     "has a median of {:.2f} over them; a tracked gripper stays under about 0.2): the [observation] "
                     "bounds may take something else for the gripper (a reflector, the background, text burned into "
                     "the frames: exclude_px), or the sensor's scale or the gripper's size is wrong; check with "
-                    "--save-masks and the overlay video",
+                    "gtrack segment and the overlay video",
                     fit_.front().first, frame.index, median);
     }
     fit_.pop_front();
