@@ -61,7 +61,10 @@ class GlRenderer final : public Renderer {
   void submit_chunk(const Eigen::MatrixXd& hypotheses, int first, int m);
   void upload_hypotheses(const double* data, int count);
   // Clears the target and draws hypotheses 0 .. count-1 into it.
-  void draw(int count);
+  // Clears the batch's layers (within `counted` only, when given: the
+  // union of the boxes the counts are taken in) and draws its hypotheses.
+  void draw(int count, const PixelBox* counted = nullptr);
+  void draw_hypotheses(int count);
   void wait_for_fence();
   void release() noexcept;
 
