@@ -70,7 +70,7 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   struct Beside {
     const char *position, *orientation, *joints;
   };
-  const Beside beside = so.preset == "microscope" ? Beside{"(paper: 25 +- 7 um)", "(paper: 1.7 +- 1.3 deg)",
+  const Beside beside = so.preset == "microscope" || so.preset == "brightfield" ? Beside{"(paper: 25 +- 7 um)", "(paper: 1.7 +- 1.3 deg)",
                                                            "(paper: 1.4 +- 0.95 deg)"}
                         : so.preset.rfind("metallic", 0) == 0
                             ? Beside{"(target: <= 10 um)", "(target: <= 2.5 deg)", "(target: <= 2.5 deg)"}

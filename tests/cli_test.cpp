@@ -966,6 +966,25 @@ TEST(Cli, SynthTakesThePresetOfTheConfigsSensor) {
                                           "\n[observation]\ncolor_space = \"luminance\"\n");
   r = gtrack("synth --config " + grey_camera.string() + " --frames 1 --out " + (dir / "c").string());
   EXPECT_NE(r.output.find("(preset ultrasound, seed 1)"), std::string::npos) << r.output;
+  // One whose bounds look for a dark gripper gets the bright-field frames,
+  // and tracks them; the ultrasound preset's, asked for, is warned about.
+  const fs::path dark_camera =
+      write("synth_preset_dark.toml", read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "tests" / "data" /
+                                                "microscope_128.toml") +
+                                          "\n[observation]\ncolor_space = \"luminance\"\nluminance_min = 0\n"
+                                          "luminance_max = 100\n");
+  r = gtrack("synth --config " + dark_camera.string() + " --frames 3 --out " + (dir / "e").string());
+  EXPECT_NE(r.output.find("(preset brightfield, seed 1)"), std::string::npos) << r.output;
+  r = gtrack(track_of(dir / "e") + " -o " + (dir / "e" / "out").string() + " --no-overlay");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("3 frames (0 lost)"), std::string::npos) << r.output;
+  r = gtrack("synth --config " + dark_camera.string() + " --preset ultrasound --frames 1 --out " +
+             (dir / "f").string());
+  EXPECT_NE(r.output.find("--preset ultrasound draws its gripper at luminance 235, its background at luminance 55, "
+                          "but the [observation] bounds of " +
+                          dark_camera.string() + " do not take the one without the other"),
+            std::string::npos)
+      << r.output;
   // A lab's copy of a metallic config, under its own name, gets the preset
   // of that gripper: the hydrogel preset's stimulus never folds it.
   const fs::path two = write("synth_preset_two.toml", read_file(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" /
@@ -1173,6 +1192,28 @@ TEST(Cli, SegmentShowsWhatTheBoundsTakeInWholeFrames) {
                              " -o " + (dir / "a_file").string());
   EXPECT_EQ(file.code, 1) << file.output;
   EXPECT_NE(file.output.find("a_file: is a file; expected a folder (--out)"), std::string::npos) << file.output;
+}
+
+// Every shipped config loads, passes the engine's checks and makes a frame
+// of the preset drawn for it.
+TEST(Cli, EveryShippedConfigMakesASequenceOfItsPreset) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "shipped_configs";
+  fs::remove_all(dir);
+  const std::map<std::string, std::string> preset_of = {
+      {"microscope_hydrogel.toml", "microscope"},          {"microscope_hydrogel_brightfield.toml", "brightfield"},
+      {"microscope_metallic_six.toml", "metallic_six"},    {"microscope_metallic_two.toml", "metallic_two"},
+      {"ultrasound_hydrogel.toml", "ultrasound"},          {"microscope_custom_gripper.toml", "microscope"}};
+  int seen = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(GTRACK_TEST_SOURCE_DIR) / "configs")) {
+    const std::string name = entry.path().filename().string();
+    ASSERT_TRUE(preset_of.count(name)) << name << ": a shipped config this test does not know";
+    const CliRun r = gtrack("synth --config " + entry.path().string() + " --frames 1 --out " + (dir / name).string());
+    EXPECT_EQ(r.code, 0) << name << ": " << r.output;
+    EXPECT_NE(r.output.find("(preset " + preset_of.at(name) + ", seed 1)"), std::string::npos) << name << ": "
+                                                                                               << r.output;
+    ++seen;
+  }
+  EXPECT_EQ(seen, static_cast<int>(preset_of.size()));
 }
 
 }  // namespace

@@ -39,6 +39,18 @@ SynthPreset metallic(const char* name, const char* config, const char* summary, 
   return p;
 }
 
+// The microscope's setup in bright field: a dark grey gripper on a light,
+// grey background, segmented by grey level (luminance 0 to 120).
+SynthPreset brightfield() {
+  SynthPreset p = microscope();
+  p.name = "brightfield";
+  p.summary = "4 mm hydrogel gripper, dark, under a 1024x1024 bright-field microscope, ~8 um/px, on a light background";
+  p.config = "microscope_hydrogel_brightfield.toml";
+  p.gripper_hsv = {0, 0, 45};
+  p.tissue_hsv = {0, 0, 195};
+  return p;
+}
+
 // B-mode ultrasound: grey levels only, a bright gripper on darker speckled
 // tissue, slow in-plane motion, small tilts and an elevational drift that
 // takes parts of the gripper out of the imaged slab.
@@ -72,7 +84,8 @@ const std::vector<SynthPreset>& synth_presets() {
                "0.9 mm six-finger metallic gripper, microscope 2 mm across (~2 um/px)", 0.1),
       metallic("metallic_two", "microscope_metallic_two.toml",
                "0.75 mm two-finger metallic gripper, microscope 1.6 mm across (~1.6 um/px)", 0.08),
-      ultrasound()};
+      ultrasound(),
+      brightfield()};
   return presets;
 }
 
