@@ -1216,4 +1216,46 @@ TEST(Cli, EveryShippedConfigMakesASequenceOfItsPreset) {
   EXPECT_EQ(seen, static_cast<int>(preset_of.size()));
 }
 
+// A config without [stimulus]: a gripper whose fold no stimulus drives is
+// tracked, its joints searched within their limits; a stimulus log or a
+// default reading then has no plugin to read it, and synth, whose fold
+// follows one, refuses: each one line naming what is missing.
+TEST(Cli, AConfigWithoutAStimulusTracksAndSaysWhatNeedsOne) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "no_stimulus";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 3 --out " + dir.string()).code, 0);
+  const std::string config = read_file(dir / "sequence.toml");
+  const size_t from = config.find("[stimulus]\n");
+  ASSERT_NE(from, std::string::npos);
+  const size_t to = config.find("\n[", from + 1);
+  ASSERT_NE(to, std::string::npos);
+  const fs::path bare = write("no_stimulus.toml", config.substr(0, from) + config.substr(to + 1));
+  const std::string frames = " -i " + (dir / "frames").string();
+  CliRun r = gtrack("track -c " + bare.string() + frames + " -o " + (dir / "out").string() + " --no-overlay");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("3 frames (0 lost)"), std::string::npos) << r.output;
+  EXPECT_EQ(read_csv(dir / "out" / "estimates.csv").size(), 4u);
+  r = gtrack("track -c " + bare.string() + frames + " -s " + (dir / "stimulus.csv").string() + " -o " +
+             (dir / "out2").string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("stimulus.csv: a stimulus log, but the config has no [stimulus] table naming the plugin "
+                          "that reads it"),
+            std::string::npos)
+      << r.output;
+  const fs::path with_default = write("no_stimulus_default.toml", replaced(read_file(bare), "[tracker]\n",
+                                                                           "[tracker]\ndefault_stimulus = 25.0\n"));
+  r = gtrack("track -c " + with_default.string() + frames + " -o " + (dir / "out3").string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("key 'tracker.default_stimulus': a default reading, but the config has no [stimulus] "
+                          "table"),
+            std::string::npos)
+      << r.output;
+  r = gtrack("synth -c " + bare.string() + " --frames 1 -o " + (dir / "seq").string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("missing table [stimulus]: a synthetic sequence's fold follows a stimulus plugin's "
+                          "readings"),
+            std::string::npos)
+      << r.output;
+}
+
 }  // namespace

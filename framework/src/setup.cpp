@@ -87,11 +87,12 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   s.gripper = loader->make_gripper(root.table("gripper"));
   warn_on_scale_mismatch(root, *s.sensor, s.model());
   if (options.with_stimulus) {
-    if (!root.has("stimulus")) {
-      root.fail("stimulus", "missing table [stimulus]; it must name a stimulus plugin" + root.misspelling_hint("stimulus"));
+    // No [stimulus]: a gripper whose fold no stimulus drives (or none is
+    // logged); the joints are searched within their limits, with no S term.
+    if (root.has("stimulus")) {
+      s.stimulus = loader->make_stimulus(root.table("stimulus"));
+      warn_on_reference_mismatch(root.table("stimulus"), s.model().geometry());
     }
-    s.stimulus = loader->make_stimulus(root.table("stimulus"));
-    warn_on_reference_mismatch(root.table("stimulus"), s.model().geometry());
   } else {
     root.mark_used("stimulus");
   }

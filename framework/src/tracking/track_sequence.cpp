@@ -570,6 +570,15 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // row as it is read, at its frame's time, so that one the plugin refuses
   // (a temperature in kelvin, a change faster than it allows) is an error
   // naming its key or its line.
+  if (!setup.stimulus && options.stimulus_csv) {
+    throw ConfigError(options.stimulus_csv->string() + ": a stimulus log, but the config has no [stimulus] table "
+                      "naming the plugin that reads it; expected one (temperature_hysteresis, threshold_hysteresis, "
+                      "a plugin of the lab's), or no --stimulus");
+  }
+  if (!setup.stimulus && config.tracker.default_stimulus) {
+    throw ConfigError(setup.root.table("tracker").where("default_stimulus") +
+                      ": a default reading, but the config has no [stimulus] table naming the plugin that reads it");
+  }
   const bool can_probe = setup.loader && setup.stimulus;
   const auto make_probe = [&] { return setup.loader->make_stimulus(setup.root.table("stimulus")); };
   if (can_probe && config.tracker.default_stimulus) {
