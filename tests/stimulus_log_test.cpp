@@ -60,6 +60,11 @@ TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
   EXPECT_EQ(error_of("frame,value\n3,20\n2,21\n"),
             "log.csv:3: expected a frame index greater than the previous row's, got '2'");
   EXPECT_EQ(error_of("time_s,value\n0.5\n"), "log.csv:2: expected two fields '<time_s>,<value>', got '0.5'");
+  // The rows after a malformed one are read on: the error lists the others.
+  EXPECT_EQ(error_of("frame,value\n0,20\n1,abc\n2,21\n3,\n4,22\n5;23\n"),
+            "log.csv:3: expected a number in the value field, got 'abc'; 2 more rows are malformed too (lines 5, 7)");
+  EXPECT_EQ(error_of("frame,value\n0,20\n1,abc\n2,21\n3,x\n"),
+            "log.csv:3: expected a number in the value field, got 'abc'; 1 more row is malformed too (line 5)");
   EXPECT_EQ(error_of("frame,value\n"), "log.csv: the stimulus log has a header but no rows");
   EXPECT_EQ(error_of(""), "log.csv: empty stimulus log; expected the header 'frame,value' or 'time_s,value'");
 }

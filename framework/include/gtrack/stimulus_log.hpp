@@ -7,7 +7,8 @@
 // several named columns (a logger's channels, `time_s,B_mT,T_C`) is read
 // from the one `column` names (required then; an error lists them). Rows must
 // be increasing in the key column. A malformed row is an InputError
-// "file:line: expected <what>, got '<text>'". A frame before the first or
+// "file:line: expected <what>, got '<text>'", which lists the lines of the
+// other malformed rows after it (parse() and load()). A frame before the first or
 // after the last row is outside the log: value_at() returns nullopt and the
 // tracker warns once and holds the nearest reading.
 //

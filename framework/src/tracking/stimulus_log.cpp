@@ -73,7 +73,35 @@ StimulusLog StimulusLog::parse(const std::string& text, const std::string& sourc
   log.column_ = column;
   std::istringstream in(text);
   std::string line;
-  while (std::getline(in, line)) log.take_line(std::move(line));
+  // A malformed row stops the run, but the rows after it are read on, so
+  // that the error lists every malformed one (a glitchy hour-long log is
+  // mended in one go, not one row a run).
+  std::string first_error;
+  std::vector<int> more;
+  while (std::getline(in, line)) {
+    const bool had_header = log.header_;
+    try {
+      log.take_line(std::move(line));
+    } catch (const InputError& e) {
+      if (!had_header || (log.refused_ && first_error.empty())) throw;
+      if (first_error.empty()) {
+        first_error = e.what();
+      } else if (!log.refused_) {
+        more.push_back(log.lines_);
+      }
+      log.refused_ = false;
+    }
+  }
+  if (!first_error.empty()) {
+    std::string lines;
+    for (size_t i = 0; i < std::min<size_t>(more.size(), 10); ++i) lines += (i ? ", " : "") + std::to_string(more[i]);
+    if (more.size() > 10) lines += ", ...";
+    throw InputError(first_error + (more.empty() ? std::string()
+                                                 : "; " + std::to_string(more.size()) + " more row" +
+                                                       (more.size() == 1 ? " is" : "s are") +
+                                                       " malformed too (line" + (more.size() == 1 ? " " : "s ") +
+                                                       lines + ")"));
+  }
   if (!log.header_) {
     throw InputError(source + ": empty stimulus log; expected the header 'frame,value' or 'time_s,value'");
   }
