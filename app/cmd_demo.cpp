@@ -57,10 +57,12 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   std::cout << "3/3 evaluating ...\n";
   const auto truth = gtrack::read_truth_table(seq / "ground_truth.csv");
   const auto estimates = gtrack::read_pose_table(to.out_dir / "estimates.csv");
-  const auto ev = gtrack::evaluate(setup.model(), truth, estimates, {}, setup.sensor.get());
+  gtrack::EvalOptions judged;
+  judged.off_track_in_plane = gtrack::cli::images_a_slab(*setup.sensor);
+  const auto ev = gtrack::evaluate(setup.model(), truth, estimates, judged, setup.sensor.get());
   const fs::path two_pass_csv = to.out_dir / "two_pass" / "estimates.csv";
   const auto ev2 =
-      gtrack::evaluate(setup.model(), truth, gtrack::read_pose_table(two_pass_csv), {}, setup.sensor.get());
+      gtrack::evaluate(setup.model(), truth, gtrack::read_pose_table(two_pass_csv), judged, setup.sensor.get());
   gtrack::write_text_file(out / "evaluation.json", gtrack::evaluation_json(ev));
   gtrack::write_frame_errors(out / "frame_errors.csv", ev);
 

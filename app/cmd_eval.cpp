@@ -243,6 +243,9 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   gtrack::EvalOptions opt;
   opt.out_of_view_below = vm["out-of-view-below"].as<double>();
   opt.off_track_endpoint_um = vm["off-track-um"].as<double>();
+  // An ultrasound slice does not show where within its slab the gripper
+  // lies: off track is judged within the imaging plane.
+  opt.off_track_in_plane = gtrack::cli::images_a_slab(*setup.sensor);
   if (!(opt.out_of_view_below >= 0 && opt.out_of_view_below < 1)) {
     throw gtrack::cli::UsageError("--out-of-view-below must be a share in [0, 1)");
   }
@@ -319,7 +322,8 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
 
   std::cout << "frames " << ev.frames << ": " << ev.in_view_frames << " in view (" << ev.evaluated_frames
             << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames
-            << " off track: endpoints > " << opt.off_track_endpoint_um << " um in 3D), "
+            << " off track: endpoints > " << opt.off_track_endpoint_um << " um "
+            << (opt.off_track_in_plane ? "in the imaging plane" : "in 3D") << "), "
             << ev.out_of_view_frames << " out of view; lost in all " << ev.lost_frames << " (missing "
             << ev.missing_frames << ")\n";
   if (ev.evaluated_frames == 0) {
@@ -384,6 +388,7 @@ GTRACK_COMMAND(
           "judge only frames A:B (A inclusive, B exclusive), as the run's --frames")(
           "every", po::value<int>()->default_value(1), "judge only every K-th frame of them, as the run's --every")(
           "off-track-um", po::value<double>()->default_value(400.0, "400"),
-          "mean endpoint error above which an estimate is off the gripper (recovery)");
+          "mean endpoint error above which an estimate is off the gripper (recovery); for an ultrasound slice, "
+          "within the imaging plane");
     },
     run_eval)

@@ -221,6 +221,30 @@ TEST(Evaluation, DepthIsAlongTheSensorsViewingAxis) {
   const auto z = gtrack::compare_to_truth(m, truth, within);
   EXPECT_NEAR(z.depth_um, 200, 1e-6);
   EXPECT_NEAR(z.inplane_um, 0, 1e-6);
+  // The endpoints, likewise: a shift across the slice moves each by 200 um
+  // in 3D and not at all within the imaging plane.
+  EXPECT_NEAR(a.endpoint_um, 200, 1e-6);
+  EXPECT_NEAR(a.endpoint_inplane_um, 0, 1e-6);
+  EXPECT_NEAR(w.endpoint_inplane_um, 200, 1e-6);
+}
+
+// An estimate 500 um across an ultrasound slice from the truth, which the
+// slice's image does not show, is off track in 3D and on track within the
+// imaging plane, as EvalOptions::off_track_in_plane judges it.
+TEST(Evaluation, OffTrackWithinTheImagingPlaneLeavesOutTheAcrossPlaneOffset) {
+  auto g = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& m = g->model();
+  const Eigen::VectorXd h = pose(0, 0, 100, 0, 0, 0, {0, 0, 0, 0, 0, 0});
+  Eigen::VectorXd deeper = h;
+  deeper[2] += 0.5;  // along the camera's axis, standing in for the slice's normal
+  gtrack::PoseTable truth, est;
+  truth.fingers = est.fingers = 6;
+  for (int f = 0; f < 3; ++f) truth.rows.push_back(row(f, h));
+  est.rows = {row(0, h), row(1, deeper), row(2, deeper)};
+  gtrack::EvalOptions in_3d, in_plane;
+  in_plane.off_track_in_plane = true;
+  EXPECT_EQ(gtrack::evaluate(m, truth, est, in_3d).off_track_frames, 2);
+  EXPECT_EQ(gtrack::evaluate(m, truth, est, in_plane).off_track_frames, 0);
 }
 
 TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {

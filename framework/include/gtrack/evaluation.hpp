@@ -38,6 +38,10 @@ struct EvalOptions {
   // An estimate whose mean endpoint error exceeds this is off the gripper:
   // it counts as not yet recovered after a return into view.
   double off_track_endpoint_um = 400;
+  // Judge off track by the endpoints' distance across the viewing axis
+  // (FrameErrors::endpoint_inplane_um): for an ultrasound slice, whose image
+  // does not show where within its slab the gripper lies.
+  bool off_track_in_plane = false;
 };
 
 struct ErrorStats {
@@ -66,6 +70,7 @@ struct FrameErrors {
   Eigen::Vector3d axis_deg{0, 0, 0};
   double joint_deg = 0;
   double endpoint_um = 0;
+  double endpoint_inplane_um = 0;  // the same, each distance taken across the viewing axis
   int symmetry_k = 0;  // the equivalent of the estimate that was compared
   // The truth is flat (every link within kFlatShare of the model's radius of
   // the palm plane) and tilted by more than kMirrorMinTiltDeg from the line

@@ -12,6 +12,12 @@ namespace gtrack {
 
 namespace {
 
+// An estimate off the gripper: its endpoints further than the threshold,
+// in 3D or across the viewing axis as the options say.
+bool off_track(const FrameErrors& e, const EvalOptions& options) {
+  return (options.off_track_in_plane ? e.endpoint_inplane_um : e.endpoint_um) > options.off_track_endpoint_um;
+}
+
 ErrorStats stats(const std::vector<double>& v) {
   ErrorStats s;
   s.count = static_cast<int>(v.size());
@@ -142,7 +148,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
         } else {
           unmirrored.push_back(fe.errors.orientation_deg);
         }
-        if (fe.errors.endpoint_um > options.off_track_endpoint_um) ++ev.off_track_frames;
+        if (off_track(fe.errors, options)) ++ev.off_track_frames;
       }
     }
     ev.per_frame.push_back(std::move(fe));
@@ -162,7 +168,7 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
     ep.returned_at = pf[i].frame;
     size_t j = i;
     for (; j < pf.size() && !pf[j].out_of_view; ++j) {
-      const bool on = !pf[j].lost && pf[j].errors.endpoint_um <= options.off_track_endpoint_um;
+      const bool on = !pf[j].lost && !off_track(pf[j].errors, options);
       if (on) {
         ep.recovered = true;
         break;

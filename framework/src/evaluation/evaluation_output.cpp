@@ -73,7 +73,8 @@ std::string evaluation_json(const Evaluation& ev) {
       << ", \"recovered\": " << (r.recovered ? "true" : "false") << "}";
   }
   o << "]},\n  \"thresholds\": {\"out_of_view_below\": " << num(ev.options.out_of_view_below)
-    << ", \"off_track_endpoint_um\": " << num(ev.options.off_track_endpoint_um) << "}\n}\n";
+    << ", \"off_track_endpoint_um\": " << num(ev.options.off_track_endpoint_um)
+    << ", \"off_track_in_plane\": " << (ev.options.off_track_in_plane ? "true" : "false") << "}\n}\n";
   return o.str();
 }
 

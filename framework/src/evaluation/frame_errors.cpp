@@ -9,9 +9,15 @@ namespace gtrack {
 
 namespace {
 
-double mean_endpoint_distance(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+// The mean distance between corresponding endpoints; with `across` (unit
+// length), of their differences less their components along it.
+double mean_endpoint_distance(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
+                              const Eigen::Vector3d* across = nullptr) {
   double sum = 0;
-  for (size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]).norm();
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Eigen::Vector3d d = a[i] - b[i];
+    sum += across ? (d - d.dot(*across) * *across).norm() : d.norm();
+  }
   return a.empty() ? 0.0 : sum / a.size();
 }
 
@@ -73,7 +79,8 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
   double best_end = 0;
   for (int k = 0; k < order; ++k) {
     const Eigen::VectorXd e = model.symmetric_equivalent(estimate, k);
-    const double end = mean_endpoint_distance(model.link_endpoints(e), truth_ends);
+    const auto ends = model.link_endpoints(e);
+    const double end = mean_endpoint_distance(ends, truth_ends);
     // The first equivalent is always taken, so that an error that is not
     // finite is reported as such, never as the default of 0.
     if (k > 0 && !(end < best_end)) continue;
@@ -81,6 +88,7 @@ FrameErrors compare_to_truth(const ArticulatedModel& model, const Eigen::VectorX
     FrameErrors f;
     f.symmetry_k = k;
     f.endpoint_um = 1000 * end;
+    f.endpoint_inplane_um = 1000 * mean_endpoint_distance(ends, truth_ends, &viewing_axis);
     const Eigen::Vector3d d = e.head<3>() - truth.head<3>();
     f.position_um = 1000 * d.norm();
     const double along = d.dot(viewing_axis);
