@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "support/logged.hpp"
 #include "support/reference_raster.hpp"
 
 namespace {
@@ -668,11 +669,6 @@ TEST(GlRenderer, ARendererUsedOnAnotherThreadMayBeDestroyedOnAThird) {
 TEST(GlRenderer, ARendererUsedOnAThreadThatEndedWorksOnAnother) {
   const ArticulatedModel model(hydrogel_geometry());
   const Eigen::MatrixXd H = camera_hypotheses(40, 29, model.fingers());
-  std::ostringstream log;
-  gtrack::logger().sinks().push_back(std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
-  struct PopSink {
-    ~PopSink() { gtrack::logger().sinks().pop_back(); }
-  } pop_sink;
   GL_OR_SKIP(gl);
   std::vector<PairCounts> there, here;
   std::string error;
@@ -686,11 +682,13 @@ TEST(GlRenderer, ARendererUsedOnAThreadThatEndedWorksOnAnother) {
     }
   }).join();
   ASSERT_EQ(error, "");
-  gl->evaluate(H, here);  // threw EGL_BAD_ACCESS while the ended thread held the context
+  const std::string log = gtrack::testing::logged([&] {
+    gl->evaluate(H, here);  // threw EGL_BAD_ACCESS while the ended thread held the context
+    gl.reset();
+  });
   ASSERT_EQ(here.size(), there.size());
   for (size_t i = 0; i < here.size(); ++i) EXPECT_EQ(here[i].rendered, there[i].rendered) << "hypothesis " << i;
-  gl.reset();
-  EXPECT_EQ(log.str().find("[warning]"), std::string::npos) << log.str();
+  EXPECT_EQ(log.find("[warning]"), std::string::npos) << log;
 }
 
 TEST(GlRenderer, ReusesItsObjectsWhenSizesChange) {

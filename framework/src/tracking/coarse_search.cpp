@@ -20,9 +20,9 @@ namespace {
 
 constexpr double kBackwardFoldDeg = 10.0;
 constexpr double kBorderStepRadii = 0.3;  // the coarse grid's step out across a border
-// O's blobs the coarse grid is also placed on, the largest first, each of at
-// least this share of the area of a disc of the model's radius (a gripper
-// mostly hidden shows little).
+// O's blobs the coarse grid is also placed on, the largest first, each
+// after it of at least this share of the area of a disc of the model's
+// radius.
 constexpr int kBlobsTried = 3;
 constexpr double kBlobShare = 0.05;
 
@@ -123,8 +123,8 @@ Eigen::Vector3d lift_pixel(const Projection& p, double u, double v, const Eigen:
 }
 
 // The centroids (pixel centres at +0.5) of a mask's 8-connected blobs, the
-// largest first: at most `most`, each of `min_area` pixels or more; none for
-// a mask of one blob or none.
+// largest first: at most `most`, each after the largest of `min_area` pixels
+// or more; none for a mask of one blob or none.
 std::vector<Eigen::Vector2d> blob_centres(const cv::Mat& mask, int most, double min_area) {
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
@@ -135,7 +135,7 @@ std::vector<Eigen::Vector2d> blob_centres(const cv::Mat& mask, int most, double 
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return area(a) > area(b); });
   std::vector<Eigen::Vector2d> centres;
   for (int i : order) {
-    if (static_cast<int>(centres.size()) == most || area(i) < min_area) break;
+    if (static_cast<int>(centres.size()) == most || (!centres.empty() && area(i) < min_area)) break;
     centres.emplace_back(centroids.at<double>(i, 0) + 0.5, centroids.at<double>(i, 1) + 0.5);
   }
   return centres;

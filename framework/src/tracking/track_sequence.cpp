@@ -606,7 +606,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                      (range.last >= 0 ? std::to_string(range.last) : std::string()));
   }
   if (log && setup.stimulus) {
-    check_log_unit(*log, *setup.stimulus, setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "");
+    const std::string plugin = setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "";
+    check_log_unit(*log, *setup.stimulus, plugin);
   }
   if (log && !options.follow_stimulus) check_log_covers_frames(*log, options, range, expected, fps, config.tracker.fps);
 
