@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <gtrack/gripper_config.hpp>
+
 #include "support/plugins.hpp"
 
 using gtrack::testing::make_gripper;
@@ -296,3 +298,25 @@ TEST(DataDefinedGripper, TooManyLinksIsRefusedAtLoad) {
 }
 
 }  // namespace
+
+// A radial gripper plugin's own defaults with a width too few: the error
+// is its author's (the defaults), not a key of the config, which sets none.
+TEST(RadialGripper, DefaultsWithAWidthTooFewBlameTheDefaults) {
+  gtrack::RadialGripperDefaults d;
+  d.spec.name = "quad";
+  d.spec.fingers = 4;
+  d.spec.palm_sides = 4;
+  d.spec.palm_circumradius_mm = 0.4;
+  for (double length : {0.36, 0.36}) d.spec.links.push_back({length, 0, 0});
+  d.widths_mm = {0.4, 0.3};
+  const auto table = gtrack::ConfigTable::parse("plugin = \"quad\"\n", "quad.toml");
+  try {
+    gtrack::radial_gripper_from_config(table, d);
+    FAIL() << "the defaults were taken";
+  } catch (const gtrack::Error& e) {
+    EXPECT_EQ(std::string(e.what()), "the gripper plugin's built-in defaults have 2 links and 2 widths; expected 3 "
+                                     "(RadialGripperDefaults::widths_mm: the width at each hinge and at the tip)");
+  }
+  d.widths_mm = {0.4, 0.3, 0.2};
+  EXPECT_EQ(gtrack::radial_gripper_from_config(table, d).fingers.size(), 4u);
+}

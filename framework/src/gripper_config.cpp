@@ -25,6 +25,14 @@ std::vector<LinkShape> links_from_config(const ConfigTable& t, const std::vector
 }
 
 GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDefaults d) {
+  // The plugin's own defaults first: a mistake there is its author's, not
+  // the config's.
+  if (d.widths_mm.size() != d.spec.links.size() + 1) {
+    throw Error("the gripper plugin's built-in defaults have " + std::to_string(d.spec.links.size()) + " link" +
+                (d.spec.links.size() == 1 ? "" : "s") + " and " + std::to_string(d.widths_mm.size()) +
+                " widths; expected " + std::to_string(d.spec.links.size() + 1) +
+                " (RadialGripperDefaults::widths_mm: the width at each hinge and at the tip)");
+  }
   RadialGripperSpec spec = d.spec;
   const Range size{0.0, ArticulatedModel::kMaxSizeMm, true, false};
   spec.palm_circumradius_mm = t.number_or("palm_circumradius_mm", spec.palm_circumradius_mm, size);
@@ -38,7 +46,8 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
     t.fail("link_widths_mm", "missing; link_lengths_mm gives " + std::to_string(lengths.size()) +
                                  " links, so the widths at their " + std::to_string(lengths.size() + 1) +
                                  " ends are needed (the built-in ones are for " +
-                                 std::to_string(d.widths_mm.size() - 1) + " links)");
+                                 std::to_string(d.widths_mm.size() - 1) +
+                                 (d.widths_mm.size() == 2 ? " link)" : " links)"));
   }
   std::vector<double> widths =
       t.numbers_or("link_widths_mm", d.widths_mm, lengths.size() + 1, Range::closed(0, ArticulatedModel::kMaxSizeMm));
