@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -100,6 +101,10 @@ int run_segment(const gtrack::cli::CommonOptions& common, const po::variables_ma
                 : fmt::format("hue {:g} to {:g}, saturation {:g} to {:g}, value {:g} to {:g}", o.hue_min, o.hue_max,
                               o.saturation_min, o.saturation_max, o.value_min, o.value_max);
   const long face_on = face_on_pixels(setup);
+  // The coarse search's measure of a blob worth a try: 5 % of a disc of the
+  // model's radius (tracking/coarse_search.cpp, at render size there).
+  const double radius_px = setup.model().radius_mm() / setup.sensor->mm_per_pixel();
+  const double tried_area = 0.05 * std::numbers::pi * radius_px * radius_px;
   std::cout << "segmenting " << source->description() << " with [observation] " << bounds
             << (o.exclude_px.empty() ? std::string() : fmt::format(", {} exclude_px rectangles", o.exclude_px.size()))
             << "; the gripper face-on at the working distance covers about " << face_on << " pixels\n";
@@ -120,30 +125,34 @@ int run_segment(const gtrack::cli::CommonOptions& common, const po::variables_ma
       cv::split(hsv, channels);
       for (int c = 0; c < 3; ++c) hists[static_cast<size_t>(c)].add(channels[c]);
     }
-    // Blobs the tracker's coarse search would consider: of at least 5 % of
-    // the face-on outline.
+    // Blobs the tracker's coarse search would try besides the largest.
     cv::Mat labels, stats, centroids;
     const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
     std::vector<int> areas;
     for (int i = 1; i < n; ++i) areas.push_back(stats.at<int>(i, cv::CC_STAT_AREA));
     std::sort(areas.rbegin(), areas.rend());
-    const auto large = std::count_if(areas.begin(), areas.end(), [&](int a) { return a >= 0.05 * face_on; });
+    const auto large = std::count_if(areas.begin(), areas.end(), [&](int a) { return a >= tried_area; });
     const int within = cv::countNonZero(mask);
     const double share = static_cast<double>(within) / mask.total();
     share_sum += share;
     std::string largest;
-    for (size_t i = 0; i < std::min<size_t>(3, areas.size()); ++i) largest += (i ? ", " : "") + std::to_string(areas[i]);
+    for (size_t i = 0; i < std::min<size_t>(3, areas.size()); ++i) {
+      largest += (i ? ", " : "") + std::to_string(areas[i]);
+    }
     std::cout << fmt::format("frame {}: {} pixels within the bounds ({:.2f} % of the image, {:.2f} times the face-on "
-                             "gripper), {} blobs, {} of them large; the largest {}\n",
+                             "gripper), {} blobs, {} of them of {:.0f} pixels or more; the largest {}\n",
                              frame->index, within, 100 * share, face_on > 0 ? double(within) / face_on : 0.0,
-                             areas.size(), large, largest.empty() ? "none" : largest);
+                             areas.size(), large, tried_area, largest.empty() ? "none" : largest);
     char name[32];
     std::snprintf(name, sizeof name, "%06d.png", frame->index);
     cv::Mat preview = image.clone();
     preview.setTo(cv::Scalar(255, 0, 255), mask);
     for (const cv::Rect& r : o.exclude_px) cv::rectangle(preview, r, cv::Scalar(128, 128, 128), 2);
-    if (!cv::imwrite((out / "masks" / name).string(), mask) || !cv::imwrite((out / "preview" / name).string(), preview)) {
-      throw gtrack::InputError((out / name).string() + ": cannot write the image");
+    using Written = std::pair<const char*, const cv::Mat*>;
+    for (const auto& [folder, image] : {Written{"masks", &mask}, Written{"preview", &preview}}) {
+      if (!cv::imwrite((out / folder / name).string(), *image)) {
+        throw gtrack::InputError((out / folder / name).string() + ": cannot write the image");
+      }
     }
     ++frames;
   }

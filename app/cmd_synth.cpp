@@ -158,8 +158,9 @@ GTRACK_COMMAND(
           "preset", po::value<std::string>()->default_value("microscope"),
           ("setup: motion, look and noise; one of " + gtrack::synth_preset_names() +
            ". With --config and no --preset: the preset whose config has the config's file name, else the one "
-           "whose config names the same gripper plugin, else microscope, or ultrasound for a config that "
-           "segments grey levels")
+           "whose config names the same gripper plugin, else the first whose look the config's bounds find "
+           "(its gripper within them, its background not): microscope in colour; ultrasound or brightfield for "
+           "grey levels")
               .c_str())(
           "joint-noise", po::value<double>()->default_value(0.0),
           "sd (deg) of per-hinge deviation from each finger's joint value (paper Fig. 6b)")(

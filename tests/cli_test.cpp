@@ -271,8 +271,8 @@ TEST(Cli, TrackRefusesALogOnAnotherClockOrInAnotherUnit) {
   };
   const CliRun late = track_with("late.csv", "time_s,T_C\n120.0,22\n121.0,23\n");
   EXPECT_EQ(late.code, 1) << late.output;
-  EXPECT_NE(late.output.find("late.csv: its rows cover t = 120.000 to 121.000 s, the frames to track t = 0.000 to "
-                             "0.067 s: none of them falls within the log"),
+  EXPECT_NE(late.output.find("late.csv: its rows cover t = 120.000 to 121.000 s, after the frames to track (t = "
+                             "0.000 to 0.067 s): none of them falls within the log"),
             std::string::npos)
       << late.output;
   EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));
@@ -282,7 +282,14 @@ TEST(Cli, TrackRefusesALogOnAnotherClockOrInAnotherUnit) {
                                    "'temperature_hysteresis' reads C"),
             std::string::npos)
       << fahrenheit.output;
-  for (const std::string& header : {"time_s,T_C", "time_s,temperature (degC)", "time_s,value"}) {
+  // A log that ends before the frames (a logger stopped early) is not
+  // refused: each frame past it holds the last reading, as said.
+  const CliRun early = track_with("early.csv", "time_s,T_C\n-2.0,22\n-1.0,23\n");
+  EXPECT_EQ(early.code, 0) << early.output;
+  EXPECT_NE(early.output.find("is outside the stimulus log"), std::string::npos) << early.output;
+  // A temperature named T is not taken for tesla.
+  for (const std::string& header :
+       {"time_s,T_C", "time_s,temperature (degC)", "time_s,value", "time_s,probe T", "time_s,sample_T"}) {
     const CliRun ok = track_with("ok.csv", header + "\n0.0,22\n1.0,23\n");
     EXPECT_EQ(ok.code, 0) << header << ": " << ok.output;
     EXPECT_EQ(ok.output.find("no frame rate"), std::string::npos) << "sequence.toml sets fps: " << ok.output;

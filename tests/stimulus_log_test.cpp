@@ -92,6 +92,14 @@ TEST(StimulusLog, AReadingTheCheckRefusesNamesItsLine) {
   }
   EXPECT_EQ(at.back(), 0.5);
   EXPECT_EQ(keys.back(), StimulusLog::Key::Time);
+  // After a malformed row, the rows the check refuses are listed too.
+  try {
+    StimulusLog::parse("frame,value\n0,22\n1,abc\n2,22\n3,400\n4,x\n", "log.csv", check);
+    ADD_FAILURE() << "a malformed log was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_STREQ(e.what(), "log.csv:3: expected a number in the value field, got 'abc'; 1 more row is malformed too "
+                           "(line 6); the stimulus plugin refuses the reading of line 5");
+  }
 }
 
 // A logger's own header: the readings' column may have any name, and of

@@ -81,19 +81,19 @@ std::string evaluation_json(const Evaluation& ev) {
 void write_frame_errors(const std::filesystem::path& file, const Evaluation& ev) {
   std::ostringstream out;
   out << "frame,in_view,out_of_view,status,lost,position_um,inplane_um,depth_um,orientation_deg,rx_err_deg,"
-         "ry_err_deg,rz_err_deg,joint_deg,endpoint_um,symmetry_k,tilt_mirror,tilt_branch\n";
+         "ry_err_deg,rz_err_deg,joint_deg,endpoint_um,symmetry_k,tilt_mirror,tilt_branch,endpoint_inplane_um\n";
   for (const auto& f : ev.per_frame) {
     out << f.frame << "," << num(f.in_view) << "," << (f.out_of_view ? 1 : 0) << "," << f.status << ","
         << (f.lost ? 1 : 0);
     if (f.lost) {
-      out << ",,,,,,,,,,,,\n";
+      out << ",,,,,,,,,,,,,\n";
       continue;
     }
     const auto& e = f.errors;
     out << "," << num(e.position_um) << "," << num(e.inplane_um) << "," << num(e.depth_um) << ","
         << num(e.orientation_deg) << "," << num(e.axis_deg[0]) << "," << num(e.axis_deg[1]) << ","
         << num(e.axis_deg[2]) << "," << num(e.joint_deg) << "," << num(e.endpoint_um) << "," << e.symmetry_k << ","
-        << (e.tilt_mirror ? 1 : 0) << "," << (e.tilt_branch ? 1 : 0) << "\n";
+        << (e.tilt_mirror ? 1 : 0) << "," << (e.tilt_branch ? 1 : 0) << "," << num(e.endpoint_inplane_um) << "\n";
   }
   write_text_file(file, out.str());
 }

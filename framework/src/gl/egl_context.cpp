@@ -29,8 +29,9 @@ bool user_sets_lp_threads() {
 }
 
 // Set only for a count asked for (0, every core, is llvmpipe's own
-// default), before the display is initialised: the environment is not
-// written while other threads may read it.
+// default), before the display is initialised, which reads it. (Other
+// threads may run then, a frame reader's among them: setenv is not safe
+// against their getenv; with 0 nothing is written.)
 void set_software_threads(int threads) {
   if (user_sets_lp_threads() || threads <= 0) return;
   setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
@@ -143,7 +144,8 @@ EglContext EglContext::open(const ContextRequest& request) {
     // A GPU left unused is refused rather than worked around on the CPU
     // a hundred times slower; asking for "surfaceless" takes that choice.
     if (const std::string missing = nvidia_without_egl(devices); !missing.empty()) {
-      throw Error("gl backend: " + missing + " (egl_device = \"surfaceless\" renders on the CPU through Mesa)");
+      throw Error("gl backend: " + missing +
+                  " ([render] egl_device = \"surfaceless\" renders on the CPU through Mesa on purpose)");
     }
     // A GPU first (NVIDIA's, then any other), then Mesa's surfaceless
     // platform (llvmpipe), then a software EGL device.

@@ -117,13 +117,15 @@ std::vector<DisplayCandidate> list_devices(std::string* why) {
 
 std::string nvidia_without_egl(const std::vector<DisplayCandidate>& devices) {
   for (const auto& d : devices) {
-    if (d.kind == DisplayKind::nvidia) return "";
+    if (d.kind == DisplayKind::nvidia || d.kind == DisplayKind::hardware) return "";  // a GPU EGL can use
   }
+  // The device nodes, which a container has only when a GPU is passed in
+  // (the driver's /proc entry shows through in any container on the host).
   std::error_code ec;
-  for (const char* file : {"/proc/driver/nvidia/version", "/dev/nvidiactl"}) {
+  for (const char* file : {"/dev/nvidiactl", "/dev/nvidia0"}) {
     if (std::filesystem::exists(file, ec)) {
-      return std::string("an NVIDIA driver is loaded (") + file +
-             ") but EGL lists no NVIDIA device: NVIDIA's EGL vendor library (libEGL_nvidia.so.0 and "
+      return std::string("an NVIDIA GPU is here (") + file +
+             ") but EGL lists no GPU device: NVIDIA's EGL vendor library (libEGL_nvidia.so.0 and "
              "/usr/share/glvnd/egl_vendor.d/10_nvidia.json) is missing or not visible; in a container, "
              "NVIDIA_DRIVER_CAPABILITIES must include graphics";
     }

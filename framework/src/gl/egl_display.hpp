@@ -28,10 +28,10 @@ struct DisplayCandidate {
 // The EGL devices in enumeration order (empty when EGL has no device
 // enumeration, or no EGL vendor library is installed; `why` then says which).
 std::vector<DisplayCandidate> list_devices(std::string* why = nullptr);
-// When the machine has an NVIDIA driver but `devices` holds no NVIDIA
-// device (its EGL vendor library missing, a container without graphics
-// capability), what is missing; "" otherwise. Rendering would then go to
-// Mesa's CPU rasteriser on a machine with a GPU.
+// When the machine has an NVIDIA GPU (its device nodes) but `devices` holds
+// no GPU device at all (NVIDIA's EGL vendor library missing, a container
+// without graphics capability), what is missing; "" otherwise. Rendering
+// would then go to Mesa's CPU rasteriser on a machine with a GPU.
 std::string nvidia_without_egl(const std::vector<DisplayCandidate>& devices);
 // Mesa's surfaceless platform, if the EGL client library offers it.
 bool surfaceless_available();

@@ -60,7 +60,6 @@ class GlRenderer final : public Renderer {
   // layers), their counts copied to their place in the read-back buffer.
   void submit_chunk(const Eigen::MatrixXd& hypotheses, int first, int m);
   void upload_hypotheses(const double* data, int count);
-  // Clears the target and draws hypotheses 0 .. count-1 into it.
   // Clears the batch's layers (within `counted` only, when given: the
   // union of the boxes the counts are taken in) and draws its hypotheses.
   void draw(int count, const PixelBox* counted = nullptr);

@@ -133,10 +133,11 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   if (!(options.occlusion_scale >= 0 && options.occlusion_scale <= 1)) {
     throw Error("the occlusion scale must be in [0, 1]");
   }
-  if (!setup.root.has("stimulus") || !setup.loader) {
+  if (!setup.root.has("stimulus")) {
     setup.root.fail("stimulus", "missing table [stimulus]: a synthetic sequence's fold follows a stimulus plugin's "
                                 "readings; expected a table naming one (temperature_hysteresis, threshold_hysteresis)");
   }
+  if (!setup.loader) throw Error("a synthetic sequence needs the setup's plugin loader, to make its stimulus anew");
   SynthPlan plan;
   plan.preset = synth_preset(options.preset);
   plan.options = options;

@@ -77,7 +77,7 @@ StimulusLog StimulusLog::parse(const std::string& text, const std::string& sourc
   // that the error lists every malformed one (a glitchy hour-long log is
   // mended in one go, not one row a run).
   std::string first_error;
-  std::vector<int> more;
+  std::vector<int> more, refused;
   while (std::getline(in, line)) {
     const bool had_header = log.header_;
     try {
@@ -86,21 +86,25 @@ StimulusLog StimulusLog::parse(const std::string& text, const std::string& sourc
       if (!had_header || (log.refused_ && first_error.empty())) throw;
       if (first_error.empty()) {
         first_error = e.what();
-      } else if (!log.refused_) {
-        more.push_back(log.lines_);
+      } else {
+        (log.refused_ ? refused : more).push_back(log.lines_);
       }
       log.refused_ = false;
     }
   }
   if (!first_error.empty()) {
-    std::string lines;
-    for (size_t i = 0; i < std::min<size_t>(more.size(), 10); ++i) lines += (i ? ", " : "") + std::to_string(more[i]);
-    if (more.size() > 10) lines += ", ...";
-    throw InputError(first_error + (more.empty() ? std::string()
-                                                 : "; " + std::to_string(more.size()) + " more row" +
-                                                       (more.size() == 1 ? " is" : "s are") +
-                                                       " malformed too (line" + (more.size() == 1 ? " " : "s ") +
-                                                       lines + ")"));
+    const auto listed = [](const std::vector<int>& rows) {
+      std::string lines = rows.size() == 1 ? "line " : "lines ";
+      for (size_t i = 0; i < std::min<size_t>(rows.size(), 10); ++i) lines += (i ? ", " : "") + std::to_string(rows[i]);
+      return lines + (rows.size() > 10 ? ", ..." : "");
+    };
+    std::string also;
+    if (!more.empty()) {
+      also += "; " + std::to_string(more.size()) + " more row" + (more.size() == 1 ? " is" : "s are") +
+              " malformed too (" + listed(more) + ")";
+    }
+    if (!refused.empty()) also += "; the stimulus plugin refuses the reading of " + listed(refused);
+    throw InputError(first_error + also);
   }
   if (!log.header_) {
     throw InputError(source + ": empty stimulus log; expected the header 'frame,value' or 'time_s,value'");

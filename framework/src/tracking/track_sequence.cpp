@@ -1,6 +1,7 @@
 // `gtrack track` as a library call: source -> Tracker -> files.
 #include <unistd.h>
 
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -179,9 +180,11 @@ std::string another_clock(const StimulusLog& log, int frame, double time_s) {
       log.source(), log.first_key(), frame, time_s);
 }
 
-// A finished stimulus log against the frames to track: one that covers none
-// of them is on another clock (a logger started before the camera), and
-// every frame would take its nearest end's reading; a time_s log with a
+// A finished time_s log against the frames to track: one whose rows all come
+// after the last of them is on another clock (a logger started before the
+// camera), and every frame would take its first row's reading (a log that
+// ends early, or one keyed by frame, is warned about as each frame outside
+// it comes); a time_s log with a
 // folder of images or a TIFF stack, which have no frame rate of their own,
 // runs on the 30 frames/s taken for them unless [tracker] fps says
 // otherwise.
@@ -199,24 +202,24 @@ void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options
   }
   if (expected <= 0) return;  // a camera or a followed folder: the frames to come are not known
   const int first = range.first, last = range.first + (expected - 1) * std::max(1, range.every);
-  const double slack = by_time ? 0.5 / fps : 0.5;
-  const double from = by_time ? first / fps : first, to = by_time ? last / fps : last;
-  if (by_time && log.first_key() > from + 86400) throw InputError(another_clock(log, first, from));
-  if (to < log.first_key() - slack || from > log.last_key() + slack) {
-    const char* unit = by_time ? "t = " : "frame ";
-    const char* suffix = by_time ? " s" : "";
-    const int digits = by_time ? 3 : 0;
+  const double slack = 0.5 / fps;
+  const double from = first / fps, to = last / fps;
+  if (!by_time) return;
+  if (log.first_key() > from + 86400) throw InputError(another_clock(log, first, from));
+  if (to < log.first_key() - slack) {
     throw InputError(fmt::format(
-        "{}: its rows cover {}{:.{}f} to {:.{}f}{}, the frames to track {}{:.{}f} to {:.{}f}{}: none of them falls "
-        "within the log; expected {} from the recording's first frame (a log started before the recording needs "
-        "that offset subtracted from its {} column)",
-        log.source(), unit, log.first_key(), digits, log.last_key(), digits, suffix, unit, from, digits, to, digits,
-        suffix, by_time ? "seconds" : "frame numbers", by_time ? "time_s" : "frame"));
+        "{}: its rows cover t = {:.3f} to {:.3f} s, after the frames to track (t = {:.3f} to {:.3f} s): none of them "
+        "falls within the log; expected seconds from the recording's first frame (a logger started before the "
+        "camera needs that offset subtracted from its time_s column)",
+        log.source(), log.first_key(), log.last_key(), from, to));
   }
 }
 
 // The unit a log's column name ends with ("T_F", "B_mT", "temp (degC)"),
 // in one spelling per unit; "" for a name that says none the check knows.
+// A single letter after "_" or a space counts only as C, F or K: "probe T"
+// or "sample_T" is a temperature named T, not tesla (which a name says as
+// "B (T)" or "B_mT").
 std::string unit_in_name(const std::string& name) {
   std::string token;
   if (const size_t open = name.find_last_of("(["); open != std::string::npos && name.size() > open + 2 &&
@@ -224,6 +227,7 @@ std::string unit_in_name(const std::string& name) {
     token = name.substr(open + 1, name.size() - open - 2);
   } else if (const size_t sep = name.find_last_of("_ "); sep != std::string::npos) {
     token = name.substr(sep + 1);
+    if (token.size() == 1 && token != "C" && token != "F" && token != "K") return "";
   }
   for (char& c : token) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   static const std::pair<const char*, const char*> spellings[] = {
@@ -242,7 +246,7 @@ std::string unit_in_name(const std::string& name) {
 // warm Celsius reading).
 void check_log_unit(const StimulusLog& log, const Stimulus& stimulus, const std::string& plugin) {
   const std::string in_log = unit_in_name(log.value_name());
-  const std::string read = unit_in_name("_" + stimulus.reading_unit());
+  const std::string read = unit_in_name("(" + stimulus.reading_unit() + ")");
   if (in_log.empty() || read.empty() || in_log == read) return;
   throw InputError(fmt::format("{}: its readings' column '{}' says {}, but the stimulus plugin '{}' reads {}; "
                                "expected readings in {} (or, for a plugin that reads several units, [stimulus] set "
@@ -339,18 +343,26 @@ class ObservationAdvice {
     // Grey within a few levels: a grey video decoded from 4:2:0 chroma
     // (H.264, MPEG-4) has channels a level or two apart, enough to give its
     // near-black pixels (a time stamp's text) a saturation above the bound.
-    cv::Mat channels[3];
+    // The largest difference between any two channels of a pixel, over all
+    // but the 0.1 % of pixels most apart (a stray coloured pixel, a
+    // decoder's ringing at an edge).
+    cv::Mat channels[3], apart, diff;
     cv::split(frame.image, channels);
-    double most = 0;
-    for (int c : {1, 2}) {
-      cv::Mat diff;
-      cv::absdiff(channels[0], channels[c], diff);
-      double apart = 0;
-      cv::minMaxLoc(diff, nullptr, &apart);
-      most = std::max(most, apart);
+    cv::absdiff(channels[0], channels[1], apart);
+    for (const auto& [a, b] : {std::pair{0, 2}, std::pair{1, 2}}) {
+      cv::absdiff(channels[a], channels[b], diff);
+      apart = cv::max(apart, diff);
+    }
+    std::array<int, 256> counts{};
+    for (auto it = apart.begin<std::uint8_t>(); it != apart.end<std::uint8_t>(); ++it) ++counts[*it];
+    int most = 0;
+    for (size_t seen = 0; most < 255; ++most) {
+      seen += static_cast<size_t>(counts[static_cast<size_t>(most)]);
+      if (seen >= apart.total() - apart.total() / 1000) break;
     }
     if (most > kGreyLevels) return false;
-    logger().warn("{}: a grey image (its channels within {} levels of each other), but [observation] color_space = "
+    logger().warn("{}: a grey image (its channels within {} levels of each other on 99.9 % of its pixels), but "
+                  "[observation] color_space = "
                   "\"hsv\" with saturation_min = {} needs colour: what passes it is noise, of dark pixels or of "
                   "the compression; {} (for grey images use color_space = \"luminance\")",
                   frame.name, most, o_.saturation_min,
@@ -389,7 +401,7 @@ class ObservationAdvice {
     fit_.pop_front();
   }
 
-  static constexpr double kGreyLevels = 3;  // channels this far apart are grey
+  static constexpr int kGreyLevels = 4;  // channels this far apart are grey (4:2:0 chroma noise of +-2)
   static constexpr int kFitFrames = 10;
   static constexpr double kPoorFit = 0.35;
   std::deque<std::pair<int, double>> fit_;  // frame, D: the last tracked frames
