@@ -438,10 +438,6 @@ void GlRenderer::draw(int count, const PixelBox* counted) {
     gl_.ClearTexSubImage(target_, 0, area.x0, area.y0, 0, area.width(), area.height(), layers_for(count),
                          GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   }
-  draw_hypotheses(count);
-}
-
-void GlRenderer::draw_hypotheses(int count) {
   gl_.UseProgram(draw_program_);
   gl_.DrawArraysInstanced(GL_TRIANGLES, 0, vertices_, count);
 }

@@ -63,7 +63,6 @@ class GlRenderer final : public Renderer {
   // Clears the batch's layers (within `counted` only, when given: the
   // union of the boxes the counts are taken in) and draws its hypotheses.
   void draw(int count, const PixelBox* counted = nullptr);
-  void draw_hypotheses(int count);
   void wait_for_fence();
   void release() noexcept;
 

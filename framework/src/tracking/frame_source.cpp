@@ -22,6 +22,7 @@
 #include <tiffio.h>
 
 #include "captured_stderr.hpp"
+#include "input_kind.hpp"
 #include "video_backend.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
@@ -633,12 +634,6 @@ class FolderSource final : public FrameSource {
 // microscope software save a recording): each page is a frame. Pages are
 // decoded a block at a time, in order; the pages before the range's first
 // are skipped without decoding (TIFF directories only).
-bool is_tiff_file(const std::string& spec) {
-  std::error_code ec;
-  if (!fs::is_regular_file(spec, ec)) return false;
-  const std::string ext = lowercase_extension(spec);
-  return ext == ".tif" || ext == ".tiff";
-}
 
 // What a stack's first page says of its layout: ImageJ writes "images=",
 // "channels=", "slices=" and "frames=" lines into its description, OME-TIFF
@@ -912,6 +907,13 @@ std::uint64_t fingerprint(const cv::Mat& image) {
 
 }  // namespace
 
+bool detail::is_tiff_file(const std::string& spec) {
+  std::error_code ec;
+  if (!fs::is_regular_file(spec, ec)) return false;
+  const std::string ext = lowercase_extension(spec);
+  return ext == ".tif" || ext == ".tiff";
+}
+
 RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector<int> frames, int every,
                                double fallback_fps)
     : spec_(std::move(spec)), expected_(expected), frames_(std::move(frames)), every_(std::max(1, every)),
@@ -928,7 +930,7 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
     }
   }
   std::error_code ec;
-  video_ = !fs::is_directory(spec_, ec) && !is_tiff_file(spec_);
+  video_ = !fs::is_directory(spec_, ec) && !detail::is_tiff_file(spec_);
 }
 
 void RecordedFrames::reading_again(FrameSource& source) const {
@@ -994,7 +996,7 @@ std::map<int, cv::Mat> RecordedFrames::read(std::size_t lo, std::size_t hi) {
     source = std::make_unique<StackSource>(spec_, expected_, range, fps_, stack_pages_);
   } else {
     source = open_frame_source(spec_, expected_, range, fps_);
-    if (is_tiff_file(spec_)) stack_pages_ = source->frame_count();
+    if (detail::is_tiff_file(spec_)) stack_pages_ = source->frame_count();
   }
   reading_again(*source);
   auto images = collect(*source);
@@ -1077,7 +1079,7 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   const fs::path p(spec);
   std::error_code ec;
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
-  if (is_tiff_file(spec)) return std::make_unique<StackSource>(spec, expected, range, fallback_fps);
+  if (detail::is_tiff_file(spec)) return std::make_unique<StackSource>(spec, expected, range, fallback_fps);
   return open_video(spec, expected, range, fallback_fps, false);  // a missing path: "no such file or folder"
 }
 

@@ -24,6 +24,7 @@
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
 #include "captured_stderr.hpp"
+#include "input_kind.hpp"
 #include "console.hpp"
 #include "nearest_equivalent.hpp"
 #include "overlay.hpp"
@@ -192,9 +193,7 @@ void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options
                              int expected, double fps, double config_fps) {
   const bool by_time = log.key() == StimulusLog::Key::Time;
   std::error_code ec;
-  std::string extension = fs::path(options.input).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const bool images = fs::is_directory(options.input, ec) || extension == ".tif" || extension == ".tiff";
+  const bool images = fs::is_directory(options.input, ec) || detail::is_tiff_file(options.input);
   if (by_time && images && config_fps <= 0) {
     logger().warn("{}: the images carry no frame rate, so {:g} frames/s is taken for the time_s log {} and the "
                   "material's response; if the camera ran at another rate, set [tracker] fps",
@@ -215,20 +214,9 @@ void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options
   }
 }
 
-// The unit a log's column name ends with ("T_F", "B_mT", "temp (degC)"),
-// in one spelling per unit; "" for a name that says none the check knows.
-// A single letter after "_" or a space counts only as C, F or K: "probe T"
-// or "sample_T" is a temperature named T, not tesla (which a name says as
-// "B (T)" or "B_mT").
-std::string unit_in_name(const std::string& name) {
-  std::string token;
-  if (const size_t open = name.find_last_of("(["); open != std::string::npos && name.size() > open + 2 &&
-                                                   (name.back() == ')' || name.back() == ']')) {
-    token = name.substr(open + 1, name.size() - open - 2);
-  } else if (const size_t sep = name.find_last_of("_ "); sep != std::string::npos) {
-    token = name.substr(sep + 1);
-    if (token.size() == 1 && token != "C" && token != "F" && token != "K") return "";
-  }
+// A unit in one spelling per unit ("degC", "°C", "celsius" -> "C"; "mt" ->
+// "mT"), whatever its case; "" for one the checks below do not know.
+std::string known_unit(std::string token) {
   for (char& c : token) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   static const std::pair<const char*, const char*> spellings[] = {
       {"c", "C"},    {"degc", "C"},  {"\u00b0c", "C"}, {"celsius", "C"}, {"f", "F"}, {"degf", "F"},
@@ -240,13 +228,29 @@ std::string unit_in_name(const std::string& name) {
   return "";
 }
 
+// The unit a log's column name ends with ("T_F", "B_mT", "temp (degC)"):
+// known_unit() of the bracketed or last part. A single letter after "_" or
+// a space counts only as C, F or K: "probe T" or "sample_T" is a temperature
+// named T, not tesla (which a name says as "B (T)" or "B_mT").
+std::string unit_in_name(const std::string& name) {
+  if (const size_t open = name.find_last_of("(["); open != std::string::npos && name.size() > open + 2 &&
+                                                   (name.back() == ')' || name.back() == ']')) {
+    return known_unit(name.substr(open + 1, name.size() - open - 2));
+  }
+  const size_t sep = name.find_last_of("_ ");
+  if (sep == std::string::npos) return "";
+  const std::string token = name.substr(sep + 1);
+  if (token.size() == 1 && token != "C" && token != "F" && token != "K") return "";
+  return known_unit(token);
+}
+
 // A log whose readings' column names its unit ("T_F") against a stimulus
 // that reads another ("C"): the readings would be taken in the wrong unit,
 // which their values alone cannot show (71 degrees Fahrenheit pass for a
 // warm Celsius reading).
 void check_log_unit(const StimulusLog& log, const Stimulus& stimulus, const std::string& plugin) {
   const std::string in_log = unit_in_name(log.value_name());
-  const std::string read = unit_in_name("(" + stimulus.reading_unit() + ")");
+  const std::string read = known_unit(stimulus.reading_unit());
   if (in_log.empty() || read.empty() || in_log == read) return;
   throw InputError(fmt::format("{}: its readings' column '{}' says {}, but the stimulus plugin '{}' reads {}; "
                                "expected readings in {} (or, for a plugin that reads several units, [stimulus] set "
