@@ -82,6 +82,17 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     opt.stimulus_column = vm["stimulus-column"].as<std::string>();
     if (opt.stimulus_column.empty()) throw gtrack::cli::UsageError("--stimulus-column: expected a column's name");
   }
+  if (vm.count("stimulus-offset")) {
+    if (!opt.stimulus_csv) throw gtrack::cli::UsageError("--stimulus-offset needs --stimulus");
+    if (vm.count("follow-stimulus")) {
+      throw gtrack::cli::UsageError("--stimulus-offset cannot be combined with --follow-stimulus (each frame takes "
+                                    "the followed log's last row, whatever its time)");
+    }
+    opt.stimulus_offset_s = vm["stimulus-offset"].as<double>();
+    if (!std::isfinite(opt.stimulus_offset_s)) {
+      throw gtrack::cli::UsageError("--stimulus-offset: expected a finite number of seconds");
+    }
+  }
   opt.out_dir = gtrack::cli::out_folder(vm);
   opt.range = gtrack::cli::frame_range_option(vm);
   opt.save_masks = vm.count("save-masks") > 0;
@@ -229,6 +240,9 @@ GTRACK_COMMAND(
           "stimulus,s", po::value<std::string>(), "stimulus log CSV (frame,value or time_s,value)")(
           "stimulus-column", po::value<std::string>(),
           "of a stimulus log with several named columns (time_s,B_mT,T_C), the one that holds the readings")(
+          "stimulus-offset", po::value<double>(),
+          "SECONDS: a time_s log on another clock: its time at the recording's first frame (a logger started "
+          "that long before the camera; a log in Unix time: the first frame's), subtracted from its times")(
           "out,o", po::value<std::string>()->required(), "output folder")(
           "backend", po::value<std::string>(), "auto, gl or cpu (default: [render] backend)")(
           "every", po::value<int>()->default_value(1), "track every K-th frame")(

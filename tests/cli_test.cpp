@@ -276,6 +276,40 @@ TEST(Cli, TrackRefusesALogOnAnotherClockOrInAnotherUnit) {
             std::string::npos)
       << late.output;
   EXPECT_FALSE(fs::exists(dir / "out" / "estimates.csv"));
+  EXPECT_NE(late.output.find("--stimulus-offset with the log's time at the first frame"), std::string::npos)
+      << late.output;
+  // The same log with its time at the first frame given: frame k (at k/30
+  // s) takes the reading at 120 + k/30 s.
+  const CliRun shifted = gtrack(track_of(dir) + " -s " + (dir / "late.csv").string() + " --stimulus-offset 120 -o " +
+                                (dir / "out").string() + " --no-overlay --log-level warn");
+  ASSERT_EQ(shifted.code, 0) << shifted.output;
+  EXPECT_EQ(shifted.output.find("outside the stimulus log"), std::string::npos) << shifted.output;
+  const std::string jsonl = read_file(dir / "out" / "estimates.jsonl");
+  for (const char* reading : {"\"stimulus\":22,", "\"stimulus\":22.0333333", "\"stimulus\":22.0666667"}) {
+    EXPECT_NE(jsonl.find(reading), std::string::npos) << reading << " in " << jsonl;
+  }
+  // An offset that leaves the frames outside the log says so, with the offset.
+  const CliRun past = gtrack(track_of(dir) + " -s " + (dir / "late.csv").string() + " --stimulus-offset 60 -o " +
+                             (dir / "out").string() + " --no-overlay --log-level warn");
+  EXPECT_EQ(past.code, 1) << past.output;
+  EXPECT_NE(past.output.find("late.csv: its rows cover t = 60.000 to 61.000 s (its time_s less --stimulus-offset "
+                             "60), after the frames to track"),
+            std::string::npos)
+      << past.output;
+  // Only a time_s log has times to shift; a followed one has no times taken.
+  std::ofstream(dir / "by_frame.csv") << "frame,value\n0,22\n2,23\n";
+  const CliRun by_frame = gtrack(track_of(dir) + " -s " + (dir / "by_frame.csv").string() +
+                                 " --stimulus-offset 5 -o " + (dir / "out").string() + " --no-overlay");
+  EXPECT_EQ(by_frame.code, 1) << by_frame.output;
+  EXPECT_NE(by_frame.output.find("by_frame.csv: is keyed by frame; a time offset (--stimulus-offset) shifts a time_s "
+                                 "log"),
+            std::string::npos)
+      << by_frame.output;
+  const CliRun followed = gtrack(track_of(dir) + " -s " + (dir / "late.csv").string() +
+                                 " --stimulus-offset 120 --follow-stimulus -o " + (dir / "out").string());
+  EXPECT_EQ(followed.code, 2) << followed.output;
+  EXPECT_NE(followed.output.find("--stimulus-offset cannot be combined with --follow-stimulus"), std::string::npos)
+      << followed.output;
   const CliRun fahrenheit = track_with("f.csv", "time_s,T_F\n0.0,71.6\n1.0,72\n");
   EXPECT_EQ(fahrenheit.code, 1) << fahrenheit.output;
   EXPECT_NE(fahrenheit.output.find("f.csv: its readings' column 'T_F' says F, but the stimulus plugin "

@@ -41,6 +41,26 @@ TEST(StimulusLog, TimeKeyedUsesFrameTime) {
   EXPECT_FALSE(log.value_at(0, 2.5));
 }
 
+// A log on another clock (Unix time): its time at the first frame taken
+// from every row, to the precision of its own times.
+TEST(StimulusLog, ATimeShiftMovesEveryRow) {
+  auto log = StimulusLog::parse("time_s,value\n1765011000.25,24.0\n1765011002.25,28.0\n", "log.csv");
+  EXPECT_FALSE(log.value_at(0, 0.5));
+  log.shift_time(1765011000.0);
+  EXPECT_DOUBLE_EQ(log.time_shift(), 1765011000.0);
+  EXPECT_DOUBLE_EQ(log.first_key(), 0.25);
+  EXPECT_NEAR(*log.value_at(0, 1.25), 26.0, 1e-6);
+  EXPECT_FALSE(log.value_at(0, 0.2));
+  auto by_frame = StimulusLog::parse("frame,value\n0,20\n10,30\n", "log.csv");
+  try {
+    by_frame.shift_time(5);
+    ADD_FAILURE() << "a frame-keyed log was shifted";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_STREQ(e.what(), "log.csv: is keyed by frame; a time offset (--stimulus-offset) shifts a time_s log");
+  }
+  EXPECT_DOUBLE_EQ(*by_frame.value_at(5, 0), 25.0);
+}
+
 TEST(StimulusLog, ErrorsNameFileLineAndWhatWasExpected) {
   EXPECT_EQ(error_of("index,temp\n"), "log.csv:1: expected the header 'frame,value' or 'time_s,value' (or the key and "
                                        "named columns, 'time_s,B_mT,T_C'), got 'index,temp'");

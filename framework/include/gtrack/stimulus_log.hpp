@@ -56,6 +56,11 @@ class GTRACK_API StimulusLog {
   int skipped_rows() const { return skipped_rows_; }
 
   Key key() const { return key_; }
+  // A time_s log on another clock: `seconds` (its time at the recording's
+  // first frame) subtracted from every row's key. Throws InputError for a
+  // log keyed by frame, or one still followed.
+  void shift_time(double seconds);
+  double time_shift() const { return shift_s_; }
   // The reading for a frame (index and time); nullopt outside the log.
   std::optional<double> value_at(int frame, double time_s) const;
   // The reading of the nearest row (for frames outside the log); the log
@@ -79,6 +84,7 @@ class GTRACK_API StimulusLog {
   size_t value_field_ = 1;   // its place in a row
   size_t field_count_ = 2;   // the fields of a row
   std::vector<double> keys_, values_;
+  double shift_s_ = 0;                   // shift_time(): seconds taken from the keys
   std::string source_;
   ReadingCheck check_;
   bool header_ = false;

@@ -196,6 +196,10 @@ struct TrackOptions {
   // The log's column of readings when it has several named ones (a
   // logger's channels); "" = its only one (StimulusLog).
   std::string stimulus_column;
+  // A time_s log on another clock (a logger started before the camera, or
+  // one in Unix time): its time at the recording's first frame, subtracted
+  // from its time_s column (--stimulus-offset).
+  double stimulus_offset_s = 0;
   std::filesystem::path out_dir;
   FrameRange range;                           // --frames A:B, --every K
   bool save_masks = false;                    // out_dir/masks/NNNNNN.png (observation O)

@@ -264,6 +264,18 @@ bool StimulusLog::poll() {
   return keys_.size() > rows_before;
 }
 
+void StimulusLog::shift_time(double seconds) {
+  if (!std::isfinite(seconds)) throw InputError(source_ + ": a time offset must be a finite number of seconds");
+  if (key_ != Key::Time) {
+    throw InputError(source_ + ": is keyed by frame; a time offset (--stimulus-offset) shifts a time_s log");
+  }
+  if (!followed_.empty()) {
+    throw InputError(source_ + ": is followed, each frame taking its last row; a time offset has nothing to shift");
+  }
+  for (double& k : keys_) k -= seconds;
+  shift_s_ += seconds;
+}
+
 std::optional<double> StimulusLog::latest() const {
   if (values_.empty()) return std::nullopt;
   return values_.back();

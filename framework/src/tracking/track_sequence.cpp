@@ -172,13 +172,18 @@ int expected_frames(const FrameSource& src, const FrameRange& r) {
   return (n - r.first + r.every - 1) / r.every;
 }
 
+// How a log's times are shown when --stimulus-offset moved them.
+std::string shifted_by(const StimulusLog& log) {
+  return log.time_shift() != 0 ? fmt::format(" (its time_s less --stimulus-offset {:g})", log.time_shift()) : "";
+}
+
 // A time_s log whose times start more than a day after a frame's: seconds
 // since 1970 (Unix time), say.
 std::string another_clock(const StimulusLog& log, int frame, double time_s) {
   return fmt::format(
-      "{}: its times start at t = {:.3f} s, more than a day after frame {} (t = {:.3f} s); expected seconds "
-      "from the recording's first frame (a log in Unix time needs its first frame's time subtracted)",
-      log.source(), log.first_key(), frame, time_s);
+      "{}: its times start at t = {:.3f} s{}, more than a day after frame {} (t = {:.3f} s); expected seconds "
+      "from the recording's first frame (a log in Unix time: --stimulus-offset with the first frame's time)",
+      log.source(), log.first_key(), shifted_by(log), frame, time_s);
 }
 
 // A finished time_s log against the frames to track: one whose rows all come
@@ -207,10 +212,10 @@ void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options
   if (log.first_key() > from + 86400) throw InputError(another_clock(log, first, from));
   if (to < log.first_key() - slack) {
     throw InputError(fmt::format(
-        "{}: its rows cover t = {:.3f} to {:.3f} s, after the frames to track (t = {:.3f} to {:.3f} s): none of them "
-        "falls within the log; expected seconds from the recording's first frame (a logger started before the "
-        "camera needs that offset subtracted from its time_s column)",
-        log.source(), log.first_key(), log.last_key(), from, to));
+        "{}: its rows cover t = {:.3f} to {:.3f} s{}, after the frames to track (t = {:.3f} to {:.3f} s): none of "
+        "them falls within the log; expected seconds from the recording's first frame (a logger started before "
+        "the camera: --stimulus-offset with the log's time at the first frame)",
+        log.source(), log.first_key(), log.last_key(), shifted_by(log), from, to));
   }
 }
 
@@ -523,6 +528,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                 " from=" + std::to_string(range.first) + " every=" + std::to_string(std::max(1, range.every)) + " stimulus=" +
                 (options.stimulus_csv ? absolute(options.stimulus_csv->string()) : std::string("none")) +
                 (options.stimulus_column.empty() ? std::string() : " column=" + options.stimulus_column) +
+                (options.stimulus_offset_s != 0 ? fmt::format(" offset={}", options.stimulus_offset_s)
+                                                : std::string()) +
                 (options.follow_stimulus ? " followed" : ""),
             1 << 16);
   // Beside the config and the files it names, what the results come from:
@@ -548,8 +555,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (!ran.empty() && ran != run) {
       throw InputError(state_file.string() + ": the interrupted run tracked " + shown(ran, 300) +
                        "; this one " + shown(run, 300) +
-                       "; cannot resume (give the same --input, first frame of --frames, --every, --stimulus and --stimulus-column, or another "
-                       "--out; a run that followed its stimulus log cannot be resumed)");
+                       "; cannot resume (give the same --input, first frame of --frames, --every, --stimulus, "
+                       "--stimulus-column and --stimulus-offset, or another --out; a run that followed its stimulus "
+                       "log cannot be resumed)");
     }
     detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root, used);
     const int every = std::max(1, range.every);
@@ -613,6 +621,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check), options.stimulus_column)
                                   : StimulusLog::load(*options.stimulus_csv, std::move(check), options.stimulus_column);
+    if (options.stimulus_offset_s != 0) log->shift_time(options.stimulus_offset_s);
   }
   const int expected = expected_frames(*source, range);
   const std::string described = source->description();
@@ -647,9 +656,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const bool rounded = by_time && time_s > log->first_key() - 0.5 / fps && time_s < log->last_key() + 0.5 / fps;
       if (!warned_range && !rounded) {
         logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.{}f} to "
-                      "{:.{}f}; holding its nearest reading",
+                      "{:.{}f}{}; holding its nearest reading",
                       log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(), by_time ? 3 : 0,
-                      log->last_key(), by_time ? 3 : 0);
+                      log->last_key(), by_time ? 3 : 0, shifted_by(*log));
         warned_range = true;
       }
       reading = log->nearest(index, time_s);
