@@ -257,7 +257,12 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   // --frames and --every as the run had them: only the frames it tracked are judged.
   const gtrack::FrameRange range = gtrack::cli::frame_range_option(vm);
   const bool had_rows = !truth.rows.empty();
-  for (auto* t : {&truth, &estimates}) std::erase_if(t->rows, [&](const auto& r) { return !range.contains(r.frame); });
+  for (auto* t : {&truth, &estimates}) {
+    std::erase_if(t->rows, [&](const auto& r) { return !range.contains(r.frame); });
+    // Frame order, whatever the files' (a table put together by hand): the
+    // ranges said below and the recoveries after a return follow it.
+    std::stable_sort(t->rows.begin(), t->rows.end(), [](const auto& a, const auto& b) { return a.frame < b.frame; });
+  }
   if (had_rows && truth.rows.empty()) {
     throw gtrack::cli::UsageError("--frames/--every select none of the frames of " + truth_file.string());
   }

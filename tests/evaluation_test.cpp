@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -277,6 +278,17 @@ TEST(Evaluation, LostMissingAndOutOfViewFramesAreCountedNotDropped) {
   EXPECT_EQ(ev.recovery[0].frames_to_recover, 2);
   EXPECT_TRUE(ev.recovery[0].recovered);
   EXPECT_EQ(ev.frames_lost_after_return, 2);
+  // The same rows in another order (a table put together by hand): the
+  // same return and recovery, the frames in order.
+  gtrack::PoseTable shuffled_truth = truth, shuffled_est = est;
+  std::reverse(shuffled_truth.rows.begin(), shuffled_truth.rows.end());
+  std::rotate(shuffled_est.rows.begin(), shuffled_est.rows.begin() + 3, shuffled_est.rows.end());
+  const auto again = gtrack::evaluate(m, shuffled_truth, shuffled_est);
+  ASSERT_EQ(again.recovery.size(), 1u);
+  EXPECT_EQ(again.recovery[0].returned_at, 6);
+  EXPECT_EQ(again.recovery[0].frames_to_recover, 2);
+  EXPECT_EQ(again.per_frame.front().frame, 0);
+  EXPECT_EQ(again.per_frame.back().frame, 8);
   // In-plane errors of the evaluated frames 0, 1, 6, 8: 0, 10, 1500, 20 um.
   EXPECT_NEAR(ev.in_view.position_inplane_um.mean, 382.5, 1e-6);
   EXPECT_NEAR(ev.in_view.position_inplane_um.median, 15, 1e-6);

@@ -378,6 +378,28 @@ TEST(Synth, SynthTableSetsTheStimulusProfile) {
   EXPECT_EQ(own.frames[100].truth.head<6>(), preset.frames[100].truth.head<6>());
 }
 
+// The depth range, the one set in millimetres, for a gripper of another
+// size than the preset's: the path along the line of sight is scaled, the
+// rest of the motion kept.
+TEST(Synth, SynthTableSetsTheDepthRange) {
+  gtrack::SynthOptions o;
+  o.frames = 300;
+  const auto preset = gtrack::plan_sequence(microscope(), o);
+  const auto own = gtrack::plan_sequence(microscope_with("depth_amplitude_mm = 0.1\n"), o);
+  EXPECT_DOUBLE_EQ(own.preset.depth_amplitude_mm, 0.1);
+  double nominal = 0;
+  for (const auto& f : preset.frames) nominal += f.truth[2] / preset.frames.size();
+  double preset_reach = 0, own_reach = 0;
+  for (size_t i = 0; i < own.frames.size(); ++i) {
+    preset_reach = std::max(preset_reach, std::abs(preset.frames[i].truth[2] - nominal));
+    own_reach = std::max(own_reach, std::abs(own.frames[i].truth[2] - nominal));
+    EXPECT_EQ(own.frames[i].truth.head<2>(), preset.frames[i].truth.head<2>());
+  }
+  EXPECT_GT(preset_reach, 0.2);
+  EXPECT_LT(own_reach, 0.12);
+  EXPECT_NEAR(own_reach / preset_reach, 0.25, 0.05);
+}
+
 TEST(Synth, SynthTableErrorsNameTheKeyAndLeaveTheFolderAlone) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_synth_table_error";
   fs::remove_all(dir);
@@ -399,6 +421,7 @@ TEST(Synth, SynthTableErrorsNameTheKeyAndLeaveTheFolderAlone) {
   EXPECT_NE(empty.find("synth.stimulus_high"), std::string::npos) << empty;
   EXPECT_NE(empty.find("greater than stimulus_low"), std::string::npos) << empty;
   EXPECT_NE(message("stimulus_period_s = 0\n").find("synth.stimulus_period_s"), std::string::npos);
+  EXPECT_NE(message("depth_amplitude_mm = -1\n").find("synth.depth_amplitude_mm"), std::string::npos);
   // Readings the stimulus plugin refuses (a profile in kelvin), by their key,
   // however few frames would reach them.
   const std::string kelvin = message("stimulus_low = 295.0\nstimulus_high = 305.0\n");

@@ -158,7 +158,7 @@ struct Evaluation {
   double tilt_branch_orientation_share = 0;
   std::vector<RecoveryEpisode> recovery;
   int frames_lost_after_return = 0;
-  std::vector<FrameEvaluation> per_frame;
+  std::vector<FrameEvaluation> per_frame;  // in frame order, whatever the truth table's
 };
 
 // `sensor` is used only when the truth has no in_view column (may be null:

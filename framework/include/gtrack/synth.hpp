@@ -41,7 +41,8 @@ struct SynthPreset {
   double frame_rate_hz = 30;
 
   // Motion. In-plane amplitudes are fractions of the room the field of view
-  // leaves around the gripper (half the view minus the gripper's radius).
+  // leaves around the gripper (half the view minus the gripper's radius);
+  // the depth amplitude is in mm ([synth] depth_amplitude_mm may set it).
   double inplane_amplitude = 0.8;
   double depth_amplitude_mm = 0.4;
   double tilt_amplitude_deg = 50;       // peak of rx and ry

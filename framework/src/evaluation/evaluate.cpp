@@ -103,7 +103,13 @@ Evaluation evaluate(const ArticulatedModel& model, const PoseTable& truth, const
   std::vector<double> unmirrored;  // orientation errors of in-view frames that are no tilt mirror
   double mirrored_sum = 0, branch_sum = 0, orientation_sum = 0;
 
-  for (const PoseRow& t : truth.rows) {
+  // Frame by frame, whatever the table's order: a return into view and the
+  // recovery after it are read from consecutive frames.
+  std::vector<const PoseRow*> in_order;
+  for (const PoseRow& t : truth.rows) in_order.push_back(&t);
+  std::stable_sort(in_order.begin(), in_order.end(), [](const PoseRow* a, const PoseRow* b) { return a->frame < b->frame; });
+  for (const PoseRow* row : in_order) {
+    const PoseRow& t = *row;
     FrameEvaluation fe;
     fe.frame = t.frame;
     auto iv = t.extra.find("in_view");

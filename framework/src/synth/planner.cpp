@@ -119,6 +119,10 @@ void apply_synth_table(SynthPreset& p, const ConfigTable& t) {
   p.stimulus_high = t.number_or("stimulus_high", p.stimulus_high);
   p.stimulus_period_s = t.number_or("stimulus_period_s", p.stimulus_period_s, Range::positive());
   p.stimulus_noise = t.number_or("stimulus_noise", p.stimulus_noise, Range::non_negative());
+  // The one motion range set in millimetres (the others scale with the view
+  // and the gripper): a gripper much smaller than the preset's moves less
+  // along the line of sight.
+  p.depth_amplitude_mm = t.number_or("depth_amplitude_mm", p.depth_amplitude_mm, Range::closed(0, 50));
   t.check_all_used();  // a misspelt key first: it explains the comparison below
   if (!(p.stimulus_low < p.stimulus_high)) {
     t.fail(t.has("stimulus_high") ? "stimulus_high" : "stimulus_low",
