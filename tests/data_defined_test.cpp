@@ -6,6 +6,7 @@
 
 #include <gtrack/gripper_config.hpp>
 
+#include "support/logged.hpp"
 #include "support/plugins.hpp"
 
 using gtrack::testing::make_gripper;
@@ -183,6 +184,22 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
       << config_error(floating);
   EXPECT_NE(config_error(with(kFourFinger, "base_mm = [0.2, 0.2]", "base_mm = [0, 0]")).find("finger[0].base_mm"),
             std::string::npos);
+  // A finger drawn into the palm, or along the edge its hinge is on, is
+  // refused with the edge's outward direction; one slanted outwards passes.
+  const std::string inward = with(kFourFinger, "direction_deg = 45", "direction_deg = 225");
+  EXPECT_NE(config_error(inward).find("key 'finger[0].direction_deg': 225 points into the palm or along its edge "
+                                      "from the base [0.2, 0.2] (the edge's outward normal is at 45 deg)"),
+            std::string::npos)
+      << config_error(inward);
+  EXPECT_NE(config_error(with(kFourFinger, "direction_deg = 45", "direction_deg = 135")).find("along its edge"),
+            std::string::npos);
+  const std::string slanted = with(with(kFourFinger, "direction_deg = 45", "direction_deg = 100"),
+                                   "symmetry_order = 4", "symmetry_order = 1");
+  EXPECT_EQ(config_error(slanted), "");
+  // Joint limits the wrong way round are shown.
+  EXPECT_NE(config_error(with(kFourFinger, "symmetry_order = 4\n", "symmetry_order = 4\njoint_min_deg = 30\njoint_max_deg = 10\n"))
+                .find("key 'joint_max_deg': 10 must be greater than joint_min_deg (30)"),
+            std::string::npos);
   // A misspelt [[finger]] leaves a finger out, which breaks the symmetry:
   // the misspelling is what is named.
   std::string misspelt = kFourFinger;
@@ -195,6 +212,32 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   }
   EXPECT_NE(config_error(reach).find("a part is 120.283 mm long or away from the palm centre"), std::string::npos)
       << config_error(reach);
+}
+
+// A gripper drawn finger by finger that a turn maps onto itself, with no
+// symmetry_order, is warned about with the order to set; one that says
+// its order, or says 1 (a mark tells the turns apart), is not.
+TEST(DataDefinedGripper, AnUnsaidSymmetryIsPointedOut) {
+  const std::string unsaid = with(kFourFinger, "symmetry_order = 4\n", "");
+  const std::string said = gtrack::testing::logged([&] { make_gripper(unsaid); });
+  EXPECT_NE(said.find("key 'symmetry_order': not set, but a turn by 90 deg maps the palm and every finger onto "
+                      "themselves"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("set symmetry_order = 4"), std::string::npos) << said;
+  EXPECT_EQ(make_gripper(unsaid)->model().geometry().symmetry_order, 1);
+  for (const std::string& order : {"symmetry_order = 4\n", "symmetry_order = 1\n"}) {
+    const std::string quiet = gtrack::testing::logged([&] { make_gripper(with(kFourFinger, "symmetry_order = 4\n", order)); });
+    EXPECT_EQ(quiet.find("symmetry_order"), std::string::npos) << order << quiet;
+  }
+  // A half turn only (one finger longer on each side): order 2 is said.
+  std::string two = with(unsaid, "link_lengths_mm = [0.3, 0.3]", "link_lengths_mm = [0.3, 0.4]");
+  two = with(two.substr(0, two.find("[[finger]]\nbase_mm = [-0.2, -0.2]")) +
+                 two.substr(two.find("[[finger]]\nbase_mm = [-0.2, -0.2]")),
+             "base_mm = [-0.2, -0.2]\ndirection_deg = 225\nlink_lengths_mm = [0.3, 0.3]",
+             "base_mm = [-0.2, -0.2]\ndirection_deg = 225\nlink_lengths_mm = [0.3, 0.4]");
+  const std::string half = gtrack::testing::logged([&] { make_gripper(two); });
+  EXPECT_NE(half.find("a turn by 180 deg maps"), std::string::npos) << half;
 }
 
 // symmetry_order is checked against the shape: a quarter turn does not map a

@@ -18,6 +18,7 @@
 #include <gtrack/error.hpp>
 #include <gtrack/gripper_config.hpp>
 #include <cstdio>
+#include <gtrack/log.hpp>
 #include <gtrack/plugin.hpp>
 
 namespace {
@@ -34,6 +35,30 @@ std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
   if (lengths.empty()) t.fail("link_lengths_mm", "needs at least one link");
   const auto widths = t.numbers("link_widths_mm", lengths.size() + 1, Range::closed(0, kMaxMm));
   return gtrack::links_from_config(t, lengths, widths);
+}
+
+// The finger leaves the palm: its direction within 90 deg of the outward
+// normal of an edge its base is on (either edge, at a corner). A finger
+// drawn inwards or along the edge crosses the palm, or lies on its outline.
+void check_outward(const ConfigTable& f, const gtrack::FingerShape& finger, const std::vector<Eigen::Vector2d>& palm,
+                   double tolerance) {
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  const Eigen::Vector2d d(std::cos(finger.direction_deg * kDeg), std::sin(finger.direction_deg * kDeg));
+  double best = -2, normal_deg = 0;
+  for (size_t i = 0; i < palm.size(); ++i) {
+    const Eigen::Vector2d a = palm[i], b = palm[(i + 1) % palm.size()];
+    if (gtrack::distance_to_outline(finger.base_mm, {a, b}) > tolerance) continue;
+    const Eigen::Vector2d n = Eigen::Vector2d(b.y() - a.y(), a.x() - b.x()).normalized();  // counter-clockwise: outward
+    if (n.dot(d) > best) best = n.dot(d), normal_deg = std::atan2(n.y(), n.x()) / kDeg;
+  }
+  if (best > -2 && best <= 1e-6) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "%g points into the palm or along its edge from the base [%g, %g] (the edge's outward normal is "
+                  "at %.4g deg); expected a direction out of the palm, less than 90 deg from that normal",
+                  finger.direction_deg, finger.base_mm.x(), finger.base_mm.y(), normal_deg);
+    f.fail("direction_deg", text);
+  }
 }
 
 gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
@@ -82,6 +107,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
         f.fail("base_mm", text);
       }
       F.direction_deg = f.number("direction_deg", Range::closed(-360, 360));
+      check_outward(f, F, g.palm_mm, 0.05 * palm_radius);
       F.links = read_links(f);
       f.check_all_used();
       g.fingers.push_back(F);
@@ -108,7 +134,11 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
   }
   g.joint_min_deg = t.number_or("joint_min_deg", 0, Range::closed(-180, 180));
   g.joint_max_deg = t.number_or("joint_max_deg", 90, Range::closed(-180, 180));
-  if (!(g.joint_min_deg < g.joint_max_deg)) t.fail("joint_max_deg", "must be greater than joint_min_deg");
+  if (!(g.joint_min_deg < g.joint_max_deg)) {
+    char text[128];
+    std::snprintf(text, sizeof text, "%g must be greater than joint_min_deg (%g)", g.joint_max_deg, g.joint_min_deg);
+    t.fail("joint_max_deg", text);
+  }
   g.collision.max_difference_deg = t.number_or("max_adjacent_difference_deg", 45, Range::positive());
   g.collision.max_sum_deg = t.number_or("max_adjacent_sum_deg", 1e9, Range::positive());
   // Default: what the geometry has already; a radial gripper is symmetric
@@ -123,6 +153,22 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
     // the unknown key is the cause to name.
     t.check_all_used();
     t.fail("symmetry_order", broken);
+  }
+  // A gripper drawn finger by finger whose palm and fingers a turn maps onto
+  // themselves, with no symmetry_order: its poses a turn apart would be told
+  // apart as if it were marked, and a sequence of it scored a turn off.
+  const int F = static_cast<int>(g.fingers.size());
+  if (!t.has("symmetry_order") && !t.has("radial") && F > 1) {
+    for (int k = F; k >= 2; --k) {
+      gtrack::GripperGeometry turned = g;
+      turned.symmetry_order = k;
+      if (F % k != 0 || !gtrack::symmetry_mismatch(turned).empty()) continue;
+      gtrack::logger().warn("{}: not set, but a turn by {:g} deg maps the palm and every finger onto themselves: "
+                            "poses a turn apart are told apart as if the gripper were marked (and scored a turn "
+                            "off); set symmetry_order = {}, or = 1 if a mark does tell them apart",
+                            t.where("symmetry_order"), 360.0 / k, k);
+      break;
+    }
   }
   return g;
 }
