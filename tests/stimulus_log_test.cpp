@@ -207,14 +207,23 @@ TEST(StimulusLog, FollowTakesAppendedWholeLines) {
   EXPECT_EQ(log.skipped_rows(), 2);
   EXPECT_EQ(log.rows(), 3u);
   EXPECT_DOUBLE_EQ(*log.latest(), 24.5);
-  // A reading the check refuses is no glitch: it stops the run.
+  // A reading the check refuses after it took one (a sensor's spike) is
+  // left out as a glitch is; a refused first reading (a log in another
+  // unit) stops the run.
   const fs::path checked = fs::temp_directory_path() / "gtrack_stimulus_follow_checked.csv";
-  std::ofstream(checked) << "frame,value\n0,22\n";
-  gtrack::StimulusLog strict = gtrack::StimulusLog::follow(checked, [](double v, gtrack::StimulusLog::Key, double) {
+  const auto too_hot = [](double v, gtrack::StimulusLog::Key, double) {
     if (v > 150) throw std::invalid_argument("too hot");
-  });
-  std::ofstream(checked, std::ios::app) << "1,295\n";
-  EXPECT_THROW(strict.poll(), gtrack::InputError);
+  };
+  std::ofstream(checked) << "frame,value\n0,22\n";
+  gtrack::StimulusLog spiked = gtrack::StimulusLog::follow(checked, too_hot);
+  std::ofstream(checked, std::ios::app) << "1,295\n2,23\n";
+  const std::string spike = gtrack::testing::logged([&] { EXPECT_TRUE(spiked.poll()); });
+  EXPECT_NE(spike.find("gtrack_stimulus_follow_checked.csv:3: too hot; the row is left out"), std::string::npos)
+      << spike;
+  EXPECT_EQ(spiked.skipped_rows(), 1);
+  EXPECT_DOUBLE_EQ(*spiked.latest(), 23.0);
+  std::ofstream(checked) << "frame,value\n0,295\n";
+  EXPECT_THROW(gtrack::StimulusLog::follow(checked, too_hot), gtrack::InputError);
   fs::remove(checked);
   std::ofstream(file) << "frame,value\n";
   EXPECT_THROW(log.poll(), gtrack::InputError);  // shrank: a new log, not this one

@@ -557,6 +557,16 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   const double read = std::stod(jsonl[4].substr(read_at + 14));
   EXPECT_GT(read, now - 600);
   EXPECT_LE(read, written);
+  // The image file's own time: when it was written, before it was read.
+  const auto file_at = jsonl[4].find("\"written_unix_s\":");
+  ASSERT_NE(file_at, std::string::npos) << jsonl[4];
+  const double file_time = std::stod(jsonl[4].substr(file_at + 17));
+  const double expected = std::chrono::duration<double>(
+                              std::chrono::file_clock::to_sys(fs::last_write_time(seq / "frames" / "000004.png"))
+                                  .time_since_epoch())
+                              .count();
+  EXPECT_NEAR(file_time, expected, 1e-5);
+  EXPECT_LE(file_time, read + 1e-3);
   EXPECT_TRUE(fs::exists(opt.out_dir / "summary.json"));
   EXPECT_TRUE(fs::exists(opt.out_dir / "masks" / "000004.png"));
   EXPECT_FALSE(s.overlay_file.empty());

@@ -37,6 +37,10 @@ struct Frame {
   // When it had been read, seconds since the Unix epoch (set by the reader
   // of gtrack track; 0 otherwise).
   double read_unix_s = 0;
+  // An image file's modification time (seconds since the Unix epoch; 0 for
+  // a video, a stack or a camera): in a followed folder, when the camera's
+  // software finished writing it.
+  double written_unix_s = 0;
 };
 
 // A half-open range [first, last) of frame indices; last < 0 = to the end.
@@ -75,6 +79,9 @@ class GTRACK_API FrameSource {
   // Once next() has ended: why the source ended before the frames it
   // declared (a video the decoder gave up on part way), or "" when it did not.
   virtual std::string ended_early() const { return {}; }
+  // Frames of the range left out, unread, for a newer one (a followed
+  // folder with FollowOptions::newest).
+  virtual int skipped() const { return 0; }
   // Significant bits of 16-bit images, 8 to 16 (default 16): a 16-bit image
   // is scaled to 8 bits by 255 / (2^bits - 1), values above 2^bits - 1
   // saturating. The first 16-bit image is warned about when its values use
@@ -105,6 +112,9 @@ class GTRACK_API FrameSource {
 struct FollowOptions {
   double idle_s = 0;                          // 0: do not follow
   const std::atomic<bool>* cancel = nullptr;  // raised: stop waiting
+  // Each frame is the newest image listed when it is asked for; the images
+  // listed before it are left out undecoded (FrameSource::skipped()).
+  bool newest = false;
 };
 
 // Throws InputError for a missing or unreadable video, an empty folder, a

@@ -43,16 +43,17 @@ class GTRACK_API StimulusLog {
   // A log still being written (a live run): poll() takes the rows appended
   // since the last call, whole lines only, with the same checks as parse()
   // (errors name the file and line); true when rows were added. The file may
-  // be empty, or hold only its header, at first. A malformed row, or one
-  // whose key does not increase, is warned about and left out (counted by
-  // skipped_rows()); a bad header, a reading the check refuses, a file that
-  // shrinks or is replaced by one without the rows read so far throw.
+  // be empty, or hold only its header, at first. A malformed row, one whose
+  // key does not increase, or a reading the check refuses once it has taken
+  // one, is warned about and left out (counted by skipped_rows()); a bad
+  // header, a first reading the check refuses, a file that shrinks or is
+  // replaced by one without the rows read so far throw.
   static StimulusLog follow(const std::filesystem::path& file, ReadingCheck check = {},
                             const std::string& column = "");
   bool poll();
   // The last row's reading; nullopt while there is none.
   std::optional<double> latest() const;
-  // follow(): the rows left out as malformed.
+  // follow(): the rows left out, malformed or refused.
   int skipped_rows() const { return skipped_rows_; }
 
   Key key() const { return key_; }

@@ -96,8 +96,10 @@ struct Estimate {
   // source, about when it arrived) and when its estimate was written
   // (seconds since the Unix epoch, this machine's clock), for matching a
   // streamed estimate with its image and measuring the delay; "" and 0
-  // otherwise.
+  // otherwise. An image file's modification time (Frame::written_unix_s)
+  // is when it was written.
   std::string image;
+  double written_unix_s = 0;
   double read_unix_s = 0;
   double unix_time_s = 0;
 };
@@ -264,7 +266,7 @@ struct TrackSummary {
   int frames_before = 0;     // --resume: rows kept from before; `frames` counts this run's only
   std::string input_ended_early;  // FrameSource::ended_early: "" when the input ended where it said it would
   int skipped_frames = 0;    // TrackOptions::newest: frames read and left out for a newer one
-  int skipped_stimulus_rows = 0;  // follow_stimulus: malformed rows of the log left out (warned about)
+  int skipped_stimulus_rows = 0;  // follow_stimulus: rows of the log left out, malformed or refused (warned about)
   std::string stopped_by;    // the error that stopped the run part way ("" when none; it is then thrown on)
 };
 

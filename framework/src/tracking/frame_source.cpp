@@ -390,6 +390,7 @@ class FolderSource final : public FrameSource {
   std::optional<Frame> next() override {
     waited_s_ = 0;
     for (;;) {
+      if (following() && follow_.newest) skip_to_newest();
       while (index_ < static_cast<int>(files_.size())) {
         if (filter_.done(index_)) return std::nullopt;
         const int i = index_++;
@@ -400,10 +401,27 @@ class FolderSource final : public FrameSource {
         f.time_s = fps_ > 0 ? i / fps_ : 0.0;
         f.name = p.string();
         cv::Mat image = read(p);
+        if (vanished_) {
+          // Renamed or removed before it was whole (a camera's software that
+          // writes under a temporary name and renames): no frame. Its name
+          // stays known, so a temporary name used again is not listed again.
+          logger().info("{}: gone before it could be read whole (renamed or removed); not a frame", p.string());
+          vanished_ = false;
+          files_.erase(files_.begin() + i);
+          index_ = i;
+          continue;
+        }
         if (image.empty()) return std::nullopt;  // cancelled while the image was still being written
         f.image = to_bgr(image, f.name);
         check_size(f.image, expected_, p.string());
         f.waited_s = waited_s_;
+        std::error_code ec;
+        const auto written = fs::last_write_time(p, ec);
+        if (!ec) {
+          f.written_unix_s = std::chrono::duration<double>(
+                                 std::chrono::file_clock::to_sys(written).time_since_epoch())
+                                 .count();
+        }
         return f;
       }
       // The range's last frame taken: nothing to wait for.
@@ -411,6 +429,7 @@ class FolderSource final : public FrameSource {
     }
   }
   double fps() const override { return fps_; }
+  int skipped() const override { return skipped_; }
   int frame_count() const override { return following() ? -1 : static_cast<int>(files_.size()); }
   std::string description() const override {
     return dir_.string() + (following() ? " (followed: new images are taken as they arrive)"
@@ -419,6 +438,20 @@ class FolderSource final : public FrameSource {
 
  private:
   bool following() const { return follow_.idle_s > 0; }
+
+  // --newest on a followed folder: the next frame is the newest image of the
+  // range listed now; those before it are left out without being decoded
+  // (reading each would keep the tracker as far behind as tracking it).
+  void skip_to_newest() {
+    scan();
+    int newest = -1;
+    for (int i = static_cast<int>(files_.size()) - 1; i >= index_ && newest < 0; --i) {
+      if (filter_.wanted(i) && !filter_.done(i)) newest = i;
+    }
+    if (newest < 0) return;
+    for (int i = index_; i < newest; ++i) skipped_ += filter_.wanted(i) ? 1 : 0;
+    index_ = newest;
+  }
 
   // The folder's images in name order. Following, scan() runs once every
   // image listed so far was taken: an image that arrives late, named before
@@ -563,9 +596,13 @@ class FolderSource final : public FrameSource {
     fs::file_time_type decoded_time;
     auto decoded_at = std::chrono::steady_clock::now();
     for (;;) {
-      std::error_code ec, ec_time;
+      std::error_code ec, ec_time, ec_exists;
       const std::uintmax_t size = fs::file_size(p, ec);
       const fs::file_time_type written = fs::last_write_time(p, ec_time);
+      if (ec && !fs::exists(p, ec_exists) && !ec_exists) {
+        vanished_ = true;
+        return {};
+      }
       // Also every 2 s: a writer that set the size first, on a file system
       // whose file times step by seconds, changes neither as it fills.
       if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time ||
@@ -615,6 +652,7 @@ class FolderSource final : public FrameSource {
 
   fs::path dir_;
   mutable double waited_s_ = 0;  // of the frame being taken
+  mutable bool vanished_ = false;  // read(): the file went away before it was whole
   std::vector<fs::path> files_;
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
   bool warned_gap_ = false;
@@ -628,6 +666,7 @@ class FolderSource final : public FrameSource {
   double fps_;
   FollowOptions follow_;
   int index_ = 0;
+  int skipped_ = 0;  // see skip_to_newest()
 };
 
 // A multi-page TIFF (a stack as ImageJ/Fiji, Micro-Manager and most

@@ -183,6 +183,7 @@ std::string estimate_json(const Estimate& e) {
   }
   if (!e.two_pass_source.empty()) j += ",\"two_pass\":\"" + e.two_pass_source + "\"";
   if (!e.image.empty()) j += ",\"image\":" + json_string(e.image);
+  if (e.written_unix_s > 0) j += ",\"written_unix_s\":" + num(e.written_unix_s, "%.6f");
   if (e.read_unix_s > 0) j += ",\"read_unix_s\":" + num(e.read_unix_s, "%.6f");
   if (e.unix_time_s > 0) j += ",\"unix_time_s\":" + num(e.unix_time_s, "%.6f");
   j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") +

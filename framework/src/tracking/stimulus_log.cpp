@@ -249,10 +249,11 @@ bool StimulusLog::poll() {
       take_line(fresh.substr(start, nl - start));
     } catch (const InputError& e) {
       // A live run goes on past a row the logger garbled (a glitch, a
-      // clock that stepped back): said, left out, the frames holding the
-      // last reading. A header that is not one, or a reading the plugin
-      // refuses (a log in another unit), still stops it.
-      if (!header_ || refused_) throw;
+      // clock that stepped back), or a reading the plugin refuses after it
+      // took others (a sensor's spike): said, left out, the frames holding
+      // the last reading. A header that is not one, or a refused first
+      // reading (a log in another unit), still stops it.
+      if (!header_ || (refused_ && keys_.empty())) throw;
       logger().warn("{}; the row is left out, and the frames hold the last reading", e.what());
       ++skipped_rows_;
     }

@@ -578,7 +578,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   std::atomic<bool> halt_reading{false};
   auto source = open_frame_source(options.input, setup.sensor->image_size(), range,
                                   config.tracker.fps > 0 ? config.tracker.fps : 30.0,
-                                  FollowOptions{options.follow_input_s, &halt_reading});
+                                  FollowOptions{options.follow_input_s, &halt_reading, options.newest});
   source->set_image_bits(config.tracker.image_bits);
   const double fps = config.tracker.fps > 0 ? config.tracker.fps : (source->fps() > 0 ? source->fps() : 30.0);
   if (resumed) check_resumed_folder(options, setup.sensor->image_size(), fps, resumed->frame);
@@ -796,7 +796,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const int found = summary.frames - summary.lost_frames;
     summary.mean_cost = found > 0 ? cost_sum / found : std::numeric_limits<double>::quiet_NaN();
     summary.input_ended_early = source->ended_early();
-    summary.skipped_frames = reader.skipped();
+    summary.skipped_frames = reader.skipped() + source->skipped();
     if (log) summary.skipped_stimulus_rows = log->skipped_rows();
     summary.mean_ms = ms_sum / n;
     summary.mean_times = {sums.segment_ms / n, sums.pso_ms / n, sums.io_ms / n};
@@ -855,6 +855,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       e.times.io_ms = io_ms;
       e.image = frame->name;
       e.read_unix_s = frame->read_unix_s;
+      e.written_unix_s = frame->written_unix_s;
       e.unix_time_s =
           std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
       results.write(e);
