@@ -202,6 +202,26 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   EXPECT_EQ(read_file(dir / "out_closed" / "estimates.csv").rfind("frame,x_mm", 0), 0u);
 }
 
+// A renderer that cannot start says so at once, not once a followed
+// folder's first image comes (here after the 60 s the run would wait).
+TEST(Cli, ARendererThatCannotStartIsSaidBeforeTheFirstImage) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "renderer_first";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 1 --seed 2 --out " + dir.string()).code, 0);
+  fs::create_directories(dir / "empty");
+  ::setenv("GTRACK_GL_COUNT_ROWS", "0", 1);
+  const auto start = std::chrono::steady_clock::now();
+  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "empty").string() +
+                          " -o " + (dir / "out").string() + " --backend gl --follow-input 60");
+  ::unsetenv("GTRACK_GL_COUNT_ROWS");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 30.0);
+  EXPECT_EQ(r.code, 1) << r.output;
+  // (The count's setting where the gl backend starts, else why it cannot.)
+  EXPECT_TRUE(r.output.find("GTRACK_GL_COUNT_ROWS='0'") != std::string::npos ||
+              r.output.find("gl backend") != std::string::npos)
+      << r.output;
+}
+
 std::vector<std::vector<std::string>> read_csv(const fs::path& file) {
   std::ifstream in(file);
   std::vector<std::vector<std::string>> rows;

@@ -666,6 +666,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     return reading;
   };
 
+  // The tracker and its renderer are made before the first frame is waited
+  // for: a renderer that cannot start (a gl backend without its device or
+  // shaders) says so at once, not when a followed folder's first image
+  // comes.
+  Tracker tracker(setup, config);
   // The first frame is read before an earlier run in the folder is
   // replaced: an input that fails at once (another image size, a video
   // that does not decode) leaves that run as it was, and so does a
@@ -694,7 +699,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // One run at a time in a folder: two would write each other's rows into
   // the same files. The lock goes with the process, however it ends.
   const OutputLock lock(options.out_dir);
-  Tracker tracker(setup, config);
   if (resumed) {
     // Refused (a state of another setup) before any file is touched.
     try {
