@@ -604,6 +604,8 @@ TEST(Fault, FollowedStimulusLogGivesEachFrameTheLatestReading) {
   std::vector<std::optional<double>> readings;
   o.on_frame = [&](const gtrack::Estimate& e) {
     readings.push_back(e.stimulus);
+    // Each reading with the age of its row, which a run takes a frame at a time.
+    EXPECT_TRUE(e.stimulus_age_s && *e.stimulus_age_s >= 0 && *e.stimulus_age_s < 60) << "frame " << e.frame;
     // After frame k the logger ends the row it had begun ("...5\n") and
     // begins the next one, 23.5 + k, half written ("0.1,23.").
     const int k = static_cast<int>(readings.size()) - 1;
@@ -620,6 +622,7 @@ TEST(Fault, FollowedStimulusLogGivesEachFrameTheLatestReading) {
     ASSERT_TRUE(readings[i]) << "frame " << i;
     EXPECT_DOUBLE_EQ(*readings[i], 23.5 + (i - 2)) << "frame " << i;
   }
+  EXPECT_NE(read_text(o.out_dir / "estimates.jsonl").find("\"stimulus_age_s\":"), std::string::npos);
 }
 
 // A folder that acquisition software is still writing (--follow-input):

@@ -1,10 +1,12 @@
 // The stimulus CSV: both headers, interpolation, and errors with file:line.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gtrack/error.hpp"
@@ -190,9 +192,15 @@ TEST(StimulusLog, FollowTakesAppendedWholeLines) {
   ASSERT_TRUE(log.latest());
   EXPECT_DOUBLE_EQ(*log.latest(), 22.5);
   EXPECT_FALSE(log.poll());  // nothing whole since
+  // The last row's age: from when it was read, until a new row comes.
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  ASSERT_TRUE(log.latest_age_s());
+  EXPECT_GE(*log.latest_age_s(), 0.06);
   append("3.0\n");
   EXPECT_TRUE(log.poll());
   EXPECT_DOUBLE_EQ(*log.latest(), 23.0);
+  EXPECT_LT(*log.latest_age_s(), 0.06);
+  EXPECT_FALSE(StimulusLog::parse("frame,value\n0,1\n").latest_age_s());  // a finished log has no age
   EXPECT_EQ(log.rows(), 2u);
   // A garbled row and one whose key steps back are said and left out: a
   // live run goes on, holding the last reading.

@@ -19,6 +19,7 @@
 // "file:line: <its message>".
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <ios>
@@ -53,6 +54,9 @@ class GTRACK_API StimulusLog {
   bool poll();
   // The last row's reading; nullopt while there is none.
   std::optional<double> latest() const;
+  // follow(): seconds since the last row was read (poll() that took it),
+  // on this machine's steady clock; nullopt while there is none.
+  std::optional<double> latest_age_s() const;
   // follow(): the rows left out, malformed or refused.
   int skipped_rows() const { return skipped_rows_; }
 
@@ -95,6 +99,7 @@ class GTRACK_API StimulusLog {
   bool gone_ = false;                    // follow(): the file is missing, and that was said
   bool refused_ = false;                 // the last row was refused by the check (not malformed)
   int skipped_rows_ = 0;                 // follow(): malformed rows left out
+  std::chrono::steady_clock::time_point latest_at_;  // follow(): when the last row was read
   // follow(): the bytes just before read_to_, which the file (or one put in
   // its place) must still hold.
   std::string tail_;

@@ -73,6 +73,9 @@ struct Estimate {
   CostTerms terms;             // of g^ against this frame's observation
   TrackStatus status = TrackStatus::Tracked;
   std::optional<double> stimulus;  // the reading used for this frame
+  // A followed stimulus log (--follow-stimulus): seconds since the row the
+  // reading came from was read, when the frame took it.
+  std::optional<double> stimulus_age_s;
   std::uint64_t observed_pixels = 0;  // |O|
   double outside_weight = 1;          // weight of P\O in D this frame ([cost] occlusion_discount)
   double outside_allowance = 0;       // P\O pixels not counted in D this frame ([cost] occlusion_budget)

@@ -172,6 +172,7 @@ std::string estimate_json(const Estimate& e) {
   for (std::size_t k = 0; k < e.unseen_fingers.size(); ++k) j += (k ? "," : "") + std::to_string(e.unseen_fingers[k]);
   j += "]";
   j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.9g") : std::string("null"));
+  if (e.stimulus_age_s) j += ",\"stimulus_age_s\":" + num(*e.stimulus_age_s, "%.3f");
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);
   if (const auto& r = e.reference_terms) {

@@ -262,6 +262,7 @@ bool StimulusLog::poll() {
   read_to_ += static_cast<std::streamoff>(end + 1);
   tail_ = (tail_ + fresh.substr(0, end + 1));
   if (tail_.size() > 256) tail_.erase(0, tail_.size() - 256);
+  if (keys_.size() > rows_before) latest_at_ = std::chrono::steady_clock::now();
   return keys_.size() > rows_before;
 }
 
@@ -280,6 +281,11 @@ void StimulusLog::shift_time(double seconds) {
 std::optional<double> StimulusLog::latest() const {
   if (values_.empty()) return std::nullopt;
   return values_.back();
+}
+
+std::optional<double> StimulusLog::latest_age_s() const {
+  if (values_.empty() || followed_.empty()) return std::nullopt;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - latest_at_).count();
 }
 
 std::optional<double> StimulusLog::value_at(int frame, double time_s) const {

@@ -638,10 +638,25 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
 
   // The reading of a frame: the log's, or its nearest past the log's ends.
   bool warned_range = false;
+  // A followed log that stops growing (a logger that hung): said once
+  // while it stays so, the frames holding its last reading.
+  constexpr double kStaleLogS = 5;
+  bool said_stale = false;
+  std::optional<double> reading_age;  // of the last reading_at(), followed
   const auto reading_at = [&](int index, double time_s) -> std::optional<double> {
     if (!log) return std::nullopt;
     if (options.follow_stimulus) {
       log->poll();
+      reading_age = log->latest_age_s();
+      if (reading_age && *reading_age > kStaleLogS && !said_stale) {
+        logger().warn("{}: the followed stimulus log has had no new row for {:.1f} s (frame {}); the frames hold its "
+                      "last reading, {:g}, and estimates.jsonl gives its age (stimulus_age_s)",
+                      log->source(), *reading_age, index, *log->latest());
+        said_stale = true;
+      } else if (reading_age && *reading_age <= kStaleLogS && said_stale) {
+        logger().info("{}: the followed stimulus log has new rows again (frame {})", log->source(), index);
+        said_stale = false;
+      }
       return log->latest();
     }
     std::optional<double> reading = log->value_at(index, time_s);
@@ -843,6 +858,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         }
       }
       Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
+      if (options.follow_stimulus) e.stimulus_age_s = reading_age;
       advice.after(*frame, e, tracker.last_observation(), summary.frames == 0);
       previous_index = frame->index;
       if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
