@@ -1194,6 +1194,26 @@ TEST(Tracker, UnseenFingersTakeTheSeenFingersFold) {
   for (int k = 0; k < 6; ++k) {
     if (q[k] != s[k]) EXPECT_NEAR(q[k], seen_sum / (6 - filled), 1e-9) << k;
   }
+  // A lost frame after it reports what that frame reported, filled joints
+  // and all (a controller holding the estimate sees no jump), while the
+  // track still holds the search's result; a resumed tracker does the same.
+  const cv::Mat empty(setup.sensor->image_size().height, setup.sensor->image_size().width, CV_8UC3,
+                      cv::Scalar(120, 125, 130));
+  gtrack::Tracker resumed(setup, on_tracker->config());
+  resumed.restore(gtrack::parse_tracker_state(
+      [&] {
+        const auto file = std::filesystem::temp_directory_path() / "gtrack_reported_state.txt";
+        gtrack::write_tracker_state(file, on_tracker->state());
+        std::ifstream in(file);
+        return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      }(),
+      "state"));
+  for (gtrack::Tracker* t : {on_tracker.get(), &resumed}) {
+    const gtrack::Estimate lost = t->process(empty, 4, 4 / 30.0, std::nullopt);
+    ASSERT_EQ(lost.status, gtrack::TrackStatus::Lost);
+    EXPECT_TRUE(lost.hypothesis.isApprox(on.hypothesis, 1e-12)) << lost.hypothesis.transpose();
+    EXPECT_TRUE(t->last_estimate()->isApprox(state, 1e-12));
+  }
   for (const char* bad : {"-0.001", "2.0", "\"small\""}) {
     const std::string m = engine_config_error(std::string("[tracker]\nunseen_joint_tolerance = ") + bad + "\n");
     EXPECT_NE(m.find("unseen_joint_tolerance"), std::string::npos) << m;

@@ -8,6 +8,7 @@
 //   reference_area 0
 //   last 0.28088680263448867 -0.65538763658777754 100.09506213033944 ...
 //   before_last -
+//   reported 0.28088680263448867 -0.65538763658777754 100.09506213033944 ...
 //   last_found 0
 //   found_step -
 //   run input=/data/rec1/frames every=1 stimulus=/data/rec1/stimulus.csv
@@ -36,6 +37,10 @@ struct TrackerState {
   // fold, so its joints can differ from the reported Estimate::hypothesis;
   // restore() continues exactly, set_estimate(e.hypothesis) does not.
   std::optional<Eigen::VectorXd> last, before_last;
+  // What the last frame not lost reported (unseen joints filled in), which
+  // a lost frame reports; states of earlier releases have none (a lost
+  // frame then reports `last`).
+  std::optional<Eigen::VectorXd> reported;
   // `last` came from a search (coarse search or re-detection); the x, y step
   // between two such estimates of consecutive frames (none: -).
   bool last_found = false;

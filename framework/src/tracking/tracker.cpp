@@ -56,6 +56,10 @@ struct Tracker::Impl {
   std::unique_ptr<CostEvaluator> cost;
   Projection render_projection;
   std::optional<Eigen::VectorXd> last;
+  // What the last frame not lost reported: `last` with its unseen fingers'
+  // joints filled in. A lost frame reports it, so that a controller that
+  // holds the last estimate sees no jump in those joints.
+  std::optional<Eigen::VectorXd> reported;
   std::optional<Eigen::VectorXd> before_last;  // the estimate before `last`, both tracked: the velocity
   // `last` was found by a search (the coarse search or re-detection), not
   // tracked; and the x, y step between two such estimates of consecutive
@@ -236,7 +240,7 @@ struct Tracker::Impl {
       ++lost;
       forget_motion();
       e.status = TrackStatus::Lost;
-      e.hypothesis = last ? *last : fallback_pose();
+      e.hypothesis = reported ? *reported : last ? *last : fallback_pose();
       show_observation();
       e.terms = cost->evaluate_one(e.hypothesis);
     } else {
@@ -408,10 +412,10 @@ struct Tracker::Impl {
         e.status = TrackStatus::Lost;
         if (!last) last = best;
         forget_motion();
-        e.hypothesis = *last;
+        e.hypothesis = reported ? *reported : *last;
         e.unseen_fingers.clear();
         e.redetected = e.mirrored = false;
-        e.terms = cost->evaluate_one(*last);
+        e.terms = cost->evaluate_one(e.hypothesis);
       } else {
         lost = 0;
         // A velocity needs two estimates of one continuous track: not across
@@ -431,6 +435,7 @@ struct Tracker::Impl {
         }
         last_found = e.status == TrackStatus::Search || e.redetected;
         last = best;
+        reported = e.hypothesis;
       }
     }
     started = true;
@@ -683,6 +688,7 @@ void Tracker::reset() {
     impl_->setup.stimulus = impl_->setup.loader->make_stimulus(impl_->setup.root.table("stimulus"));
   }
   impl_->last.reset();
+  impl_->reported.reset();
   impl_->forget_motion();
   impl_->reference_area = 0;
   impl_->started = false;
@@ -695,6 +701,7 @@ TrackerState Tracker::state() const {
   TrackerState s;
   s.frame = impl_->last_frame;
   s.last = impl_->last;
+  s.reported = impl_->reported;
   s.before_last = impl_->before_last;
   s.last_found = impl_->last_found;
   if (impl_->found_step) s.found_step = Eigen::VectorXd(*impl_->found_step);
@@ -706,7 +713,7 @@ TrackerState Tracker::state() const {
 
 void Tracker::restore(const TrackerState& s) {
   const int dims = impl_->config.space.dims();
-  for (const auto* h : {&s.last, &s.before_last}) {
+  for (const auto* h : {&s.last, &s.reported, &s.before_last}) {
     if (*h && (*h)->size() != dims) {
       throw Error("holds a configuration of " + std::to_string((*h)->size()) + " values, this setup has " +
                   std::to_string(dims));
@@ -715,12 +722,13 @@ void Tracker::restore(const TrackerState& s) {
   if (s.found_step && s.found_step->size() != 2) {
     throw Error("holds a found step of " + std::to_string(s.found_step->size()) + " values, expected 2 (x, y)");
   }
-  for (const auto* h : {&s.last, &s.before_last}) {
+  for (const auto* h : {&s.last, &s.reported, &s.before_last}) {
     if (*h && !(*h)->allFinite()) throw Error("holds a configuration that is not finite (nan or inf)");
   }
   if (s.found_step && !s.found_step->allFinite()) throw Error("holds a found step that is not finite (nan or inf)");
   impl_->last_frame = s.frame;
   impl_->last = s.last;
+  impl_->reported = s.reported;
   impl_->before_last = s.before_last;
   impl_->last_found = s.last_found;
   impl_->found_step.reset();
@@ -744,6 +752,7 @@ void Tracker::set_estimate(const Eigen::VectorXd& hypothesis) {
   }
   if (!hypothesis.allFinite()) throw Error("set_estimate: the configuration is not finite (nan or inf)");
   impl_->last = impl_->frame.from_world(hypothesis);
+  impl_->reported = impl_->last;
   impl_->forget_motion();
   impl_->started = true;
   impl_->lost = 0;

@@ -45,6 +45,7 @@ void write_tracker_state(const fs::path& file, const TrackerState& s, bool durab
       << "reference_area " << s.reference_area << "\n";
   write_vector(out, "last", s.last);
   write_vector(out, "before_last", s.before_last);
+  write_vector(out, "reported", s.reported);
   out << "last_found " << (s.last_found ? 1 : 0) << "\n";
   write_vector(out, "found_step", s.found_step);
   if (!s.run.empty()) {
@@ -83,7 +84,7 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
       s.run = line.substr(4);
       continue;
     }
-    if (key == "last" || key == "before_last" || key == "found_step") {
+    if (key == "last" || key == "before_last" || key == "reported" || key == "found_step") {
       std::vector<double> v;
       std::string tok;
       bool none = false;
@@ -100,7 +101,7 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
       if (none != v.empty()) fail("expected '-' or the values of a configuration after '" + key + "'");
       if (!none) {
         if (key == "found_step" && v.size() != 2) fail("expected '-' or two values (x, y) after 'found_step'");
-        (key == "last" ? s.last : key == "before_last" ? s.before_last : s.found_step) =
+        (key == "last" ? s.last : key == "before_last" ? s.before_last : key == "reported" ? s.reported : s.found_step) =
             Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
       }
       continue;
@@ -140,7 +141,8 @@ TrackerState parse_tracker_state(std::string_view text, const std::string& name)
     fail("incomplete tracker state (no header or no frame line)");
   }
   // Every line is written every time: one that is missing means the file
-  // was damaged, and a default in its place would resume a different track.
+  // was damaged, and a default in its place would resume a different track
+  // (but `reported`, which states of earlier releases lack).
   for (const char* key :
        {"lost", "started", "reference_area", "last", "before_last", "last_found", "found_step"}) {
     if (!seen.count(key)) fail(std::string("missing the '") + key + "' line of a tracker state");
