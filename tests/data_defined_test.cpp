@@ -325,6 +325,17 @@ TEST(DataDefinedGripper, AMissingModelFileNamesItsKey) {
   EXPECT_NE(missing.find("key 'model_file': /nonexistent/m.toml does not exist"), std::string::npos) << missing;
   const std::string folder = config_error("plugin = \"data_defined\"\nmodel_file = \"/tmp\"\n");
   EXPECT_NE(folder.find("key 'model_file': /tmp is a folder"), std::string::npos) << folder;
+  // A model file written as a config's [gripper] table is told where its
+  // keys go.
+  const auto file = std::filesystem::temp_directory_path() / "gtrack_model_in_a_table.toml";
+  std::string tabled = "[gripper]\n" + with(kFourFinger, "[[finger]]", "[[gripper.finger]]");
+  tabled = with(tabled, "plugin = \"data_defined\"\n", "");
+  std::ofstream(file) << tabled;
+  const std::string in_table =
+      config_error("plugin = \"data_defined\"\nmodel_file = \"" + file.string() + "\"\n");
+  EXPECT_NE(in_table.find("key 'gripper': a model file holds the gripper's keys at its top level"), std::string::npos)
+      << in_table;
+  std::filesystem::remove(file);
 }
 
 // More links than the renderers have slots for: refused when the model is

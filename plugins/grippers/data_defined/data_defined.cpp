@@ -62,6 +62,11 @@ void check_outward(const ConfigTable& f, const gtrack::FingerShape& finger, cons
 }
 
 gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
+  if (t.path().empty() && t.has("gripper")) {
+    // A model file written as a config's [gripper] table.
+    t.fail("gripper", "a model file holds the gripper's keys at its top level (name, palm_mm, [[finger]]), not "
+                      "in a [gripper] table");
+  }
   gtrack::GripperGeometry g;
   const std::string name = t.string_or("name", "data_defined");
   if (t.has("radial")) {
