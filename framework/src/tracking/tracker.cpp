@@ -52,6 +52,11 @@ struct Tracker::Impl {
   // extends the image by half its size on every side (a cpu renderer of its
   // own; one mask a frame, and only while the model reaches a border).
   std::unique_ptr<Renderer> whole_view;
+  // The previous estimate's mask, once a frame: drawn on the CPU when the
+  // search renders elsewhere (a GPU), where reading one mask back would
+  // stall the pipeline every frame for a few thousand pixels.
+  std::unique_ptr<Renderer> mask_view;
+  Renderer& masks() { return mask_view ? *mask_view : *renderer; }
   std::unique_ptr<Segmenter> segmenter;
   std::unique_ptr<CostEvaluator> cost;
   Projection render_projection;
@@ -99,6 +104,11 @@ struct Tracker::Impl {
     whole.threads = 1;
     whole_view = make_cpu_renderer(whole);
     whole_view->set_model(setup.model());
+    if (renderer->name() != "cpu") {
+      mask_view = make_cpu_renderer(whole);
+      mask_view->set_model(setup.model());
+      mask_view->set_projection(projection, config.render.scale);
+    }
     // Padded in render pixels, so that both canvases share one pixel grid.
     whole_view->set_projection(
         padded_projection(render_projection, render_projection.size.width / 2, render_projection.size.height / 2),
@@ -192,7 +202,7 @@ struct Tracker::Impl {
     Observation fresh;
     if (!searching) {
       ObservationPrior prior;
-      prior.previous_mask = renderer->render_mask(*last);
+      prior.previous_mask = masks().render_mask(*last);
       prior.margin_scale = 1.0 + lost;
       previous_area = whole_area(*last, prior.previous_mask);
       fresh = segmenter->observe(frame, &prior);
@@ -785,7 +795,7 @@ CostTerms Tracker::score_after(const Eigen::VectorXd& hypothesis, const Eigen::V
   auto& cost = *impl_->cost;
   const double allowance = cost.outside_allowance(), tolerance = cost.outside_tolerance();
   const Eigen::VectorXd before = impl_->frame.from_world(previous);
-  impl_->set_allowance(impl_->whole_area(before, impl_->renderer->render_mask(before)));
+  impl_->set_allowance(impl_->whole_area(before, impl_->masks().render_mask(before)));
   const CostTerms terms = score(hypothesis);
   cost.set_outside_allowance(allowance, tolerance);
   return terms;
