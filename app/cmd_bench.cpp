@@ -3,11 +3,13 @@
 // ~114 px across at 256x256. Hypotheses per second for batches of --batch
 // (32), and frames per second of the paper's PSO (N = 32, G = 25) per
 // backend.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "command.hpp"
 #include "gtrack/bench.hpp"
@@ -66,6 +68,8 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const int batch = vm["batch"].as<int>();
   if (batch < 1 || batch > 4096) throw gtrack::cli::UsageError("--batch must be in 1-4096 hypotheses");
   const bool json = vm.count("json") > 0;
+  const int rounds = vm["rounds"].as<int>();
+  if (rounds < 1 || rounds > 100) throw gtrack::cli::UsageError("--rounds must be in 1-100");
   const int all = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   std::string gripper_source;
@@ -74,59 +78,76 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gtrack::logger().info("bench: {} at {}x{}, {:.0f} px across, {} s per measurement", gripper_source, kSide, kSide,
                         kGripperPx, seconds);
 
-  auto hypotheses = [&](gtrack::Renderer& r) {
-    return gtrack::measure_hypotheses(r, scene, seconds, batch).per_second;
+  // The backends take turns, round after round, each measurement's time
+  // split over the rounds: a burst of other work on the machine then
+  // falls on every backend alike rather than on whichever ran during it.
+  // Each figure is the median of its rounds, and a ratio the median of
+  // the rounds' own ratios.
+  const double slice = seconds / rounds;
+  struct Backend {
+    std::unique_ptr<gtrack::Renderer> renderer;
+    std::string why;
+    bool frames = false;  // also PSO frames/s
+    std::vector<double> hyp, fps;
   };
-  auto frames = [&](gtrack::Renderer& r) { return gtrack::measure_pso_frames(r, scene, seconds).per_second; };
-
-  Measured cpu1, cpu_all, cpu_frames, base1, base_all, gl, gl_frames;
-  {
-    std::string why;
-    auto r = try_make(gtrack::make_cpu_renderer, 1, why);
-    cpu1.value = hypotheses(*r);
-    r = try_make(gtrack::make_cpu_renderer, all, why);
-    cpu_all.value = hypotheses(*r);
-    cpu_frames.value = frames(*r);
-  }
-  {
-    std::string why;
-    auto r = try_make(gtrack::make_opencv_baseline, 1, why);
-    base1.value = hypotheses(*r);
-    r = try_make(gtrack::make_opencv_baseline, all, why);
-    base_all.value = hypotheses(*r);
-  }
-  {
-    std::string why;
-    if (auto r = try_make(gtrack::make_gl_renderer, 0, why)) {
+  std::string why;
+  Backend cpu1{try_make(gtrack::make_cpu_renderer, 1, why)}, cpu_all{try_make(gtrack::make_cpu_renderer, all, why)},
+      base1{try_make(gtrack::make_opencv_baseline, 1, why)}, base_all{try_make(gtrack::make_opencv_baseline, all, why)},
+      gl;
+  gl.renderer = try_make(gtrack::make_gl_renderer, 0, gl.why);
+  cpu_all.frames = gl.frames = true;
+  std::vector<double> ratio1, ratio_n;
+  for (int round = 0; round < rounds; ++round) {
+    for (Backend* b : {&cpu1, &cpu_all, &base1, &base_all, &gl}) {
+      if (!b->renderer) continue;
       try {
-        gl.value = hypotheses(*r);
-        gl_frames.value = frames(*r);
+        b->hyp.push_back(gtrack::measure_hypotheses(*b->renderer, scene, slice, batch).per_second);
+        if (b->frames) b->fps.push_back(gtrack::measure_pso_frames(*b->renderer, scene, slice).per_second);
       } catch (const gtrack::Error& e) {
-        why = e.what();
+        b->why = e.what();  // (the gl backend failing part way: the others go on)
+        b->renderer.reset();
+        b->hyp.clear();
+        b->fps.clear();
       }
     }
-    gl.note = gl_frames.note = why;
+    ratio1.push_back(cpu1.hyp.back() / base1.hyp.back());
+    ratio_n.push_back(cpu_all.hyp.back() / base_all.hyp.back());
   }
-  const double ratio_all = *cpu_all.value / *base_all.value;
-  const double ratio_one = *cpu1.value / *base1.value;
-
+  const auto median = [](std::vector<double> v) -> std::optional<double> {
+    if (v.empty()) return std::nullopt;
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  const auto range = [](const std::vector<double>& v) {
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    char text[48];
+    std::snprintf(text, sizeof text, "%.1f-%.1f", *lo, *hi);
+    return std::string(text);
+  };
+  const Measured m_cpu1{median(cpu1.hyp)}, m_cpu_all{median(cpu_all.hyp)}, m_cpu_frames{median(cpu_all.fps)},
+      m_base1{median(base1.hyp)}, m_base_all{median(base_all.hyp)}, m_gl{median(gl.hyp), gl.why},
+      m_gl_frames{median(gl.fps), gl.why};
+  const double ratio_one = *median(ratio1), ratio_all = *median(ratio_n);
   if (json) {
-    std::cout << "{\"hypotheses_per_s\": {\"cpu\": " << json_number(cpu_all.value)
-              << ", \"gl\": " << json_number(gl.value) << ", \"opencv_baseline\": " << json_number(base_all.value)
-              << "},\n \"frames_per_s\": {\"cpu\": " << json_number(cpu_frames.value)
-              << ", \"gl\": " << json_number(gl_frames.value) << "},\n"
+    std::cout << "{\"hypotheses_per_s\": {\"cpu\": " << json_number(m_cpu_all.value)
+              << ", \"gl\": " << json_number(m_gl.value) << ", \"opencv_baseline\": " << json_number(m_base_all.value)
+              << "},\n \"frames_per_s\": {\"cpu\": " << json_number(m_cpu_frames.value)
+              << ", \"gl\": " << json_number(m_gl_frames.value) << "},\n"
               << " \"frames_per_s_is\": \"full PSO search of one frame: N=32 particles, G=25 generations, cost "
                  "of eq. (1); no segmentation or I/O\",\n"
-              << " \"cpu_hypotheses_per_s_by_threads\": {\"1\": " << json_number(cpu1.value) << ", \"" << all
-              << "\": " << json_number(cpu_all.value) << "},\n"
-              << " \"opencv_baseline_hypotheses_per_s_by_threads\": {\"1\": " << json_number(base1.value) << ", \""
-              << all << "\": " << json_number(base_all.value) << "},\n"
+              << " \"cpu_hypotheses_per_s_by_threads\": {\"1\": " << json_number(m_cpu1.value) << ", \"" << all
+              << "\": " << json_number(m_cpu_all.value) << "},\n"
+              << " \"opencv_baseline_hypotheses_per_s_by_threads\": {\"1\": " << json_number(m_base1.value) << ", \""
+              << all << "\": " << json_number(m_base_all.value) << "},\n"
               << " \"cpu_over_opencv_baseline\": {\"1\": " << json_number(ratio_one) << ", \"" << all
               << "\": " << json_number(ratio_all) << "},\n"
               << " \"threads\": " << all << ", \"batch\": " << batch << ", \"render_size\": [" << kSide << ", " << kSide
               << "], \"gripper_px\": " << kGripperPx << ", \"gripper\": " << gtrack::json_string(gripper_source)
-              << ", \"seconds_per_measurement\": " << seconds;
-    if (!gl.value) std::cout << ",\n \"gl_unavailable\": " << gtrack::json_string(gl.note);
+              << ", \"seconds_per_measurement\": " << seconds << ", \"rounds\": " << rounds
+              << ", \"cpu_over_opencv_baseline_range\": {\"1\": \"" << range(ratio1) << "\", \"" << all << "\": \""
+              << range(ratio_n) << "\"}";
+    if (!m_gl.value) std::cout << ",\n \"gl_unavailable\": " << gtrack::json_string(m_gl.note);
     std::cout << "}\n";
     return 0;
   }
@@ -134,14 +155,16 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   std::printf("gtrack bench: %s, %dx%d render, gripper ~%.0f px across, batches of %d\n\n", gripper_source.c_str(),
               kSide, kSide, kGripperPx, batch);
   std::printf("%-18s %12s %14s %16s\n", "backend", "threads", "hypotheses/s", "PSO frames/s");
-  std::printf("%-18s %12d %14s %16s\n", "cpu", 1, human(cpu1.value).c_str(), "");
-  std::printf("%-18s %12d %14s %16s\n", "cpu", all, human(cpu_all.value).c_str(), human(cpu_frames.value).c_str());
-  std::printf("%-18s %12s %14s %16s\n", "gl", "", human(gl.value).c_str(), human(gl_frames.value).c_str());
-  std::printf("%-18s %12d %14s %16s\n", "opencv_baseline", 1, human(base1.value).c_str(), "");
-  std::printf("%-18s %12d %14s %16s\n", "opencv_baseline", all, human(base_all.value).c_str(), "");
-  std::printf("\ncpu / opencv_baseline: %.1fx (1 thread), %.1fx (%d threads)\n", ratio_one, ratio_all, all);
+  std::printf("%-18s %12d %14s %16s\n", "cpu", 1, human(m_cpu1.value).c_str(), "");
+  std::printf("%-18s %12d %14s %16s\n", "cpu", all, human(m_cpu_all.value).c_str(), human(m_cpu_frames.value).c_str());
+  std::printf("%-18s %12s %14s %16s\n", "gl", "", human(m_gl.value).c_str(), human(m_gl_frames.value).c_str());
+  std::printf("%-18s %12d %14s %16s\n", "opencv_baseline", 1, human(m_base1.value).c_str(), "");
+  std::printf("%-18s %12d %14s %16s\n", "opencv_baseline", all, human(m_base_all.value).c_str(), "");
+  std::printf("\ncpu / opencv_baseline: %.1fx (1 thread), %.1fx (%d threads): the medians of %d rounds' ratios "
+              "(ranges %s and %s)\n",
+              ratio_one, ratio_all, all, rounds, range(ratio1).c_str(), range(ratio_n).c_str());
   std::printf("PSO frame = N=32 particles x G=25 generations with the cost of eq. (1); no segmentation or I/O\n");
-  if (!gl.value) std::printf("gl: not measured: %s\n", gl.note.c_str());
+  if (!m_gl.value) std::printf("gl: not measured: %s\n", m_gl.note.c_str());
   return 0;
 }
 
@@ -150,7 +173,10 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
 GTRACK_COMMAND("bench", "throughput of every render backend and of the OpenCV baseline, in one run",
                [](po::options_description& d) {
                  d.add_options()("json", "print one JSON object instead of a table")(
-                     "seconds", po::value<double>()->default_value(1.0), "time spent on each measurement")(
+                     "seconds", po::value<double>()->default_value(1.0),
+                     "time spent on each measurement, over all rounds")(
+                     "rounds", po::value<int>()->default_value(3),
+                     "the backends take turns this many times; each figure is the median of its rounds")(
                      "batch", po::value<int>()->default_value(32),
                      "hypotheses per batch for hypotheses/s (a swarm's N; PSO frames/s keep N = 32)");
                },

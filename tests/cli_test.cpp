@@ -971,6 +971,19 @@ TEST(Cli, UsageErrors) {
   r = gtrack("bench --batch 0");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--batch must be in 1-4096 hypotheses"), std::string::npos) << r.output;
+  // A short bench gives every figure, from the rounds asked for (what
+  // they measure is the benchmark's business, not a test's).
+  r = gtrack("bench --json --seconds 0.2 --rounds 2", "2>/dev/null");
+  EXPECT_EQ(r.code, 0) << r.output;
+  for (const char* key : {"\"hypotheses_per_s\": {\"cpu\": ", "\"frames_per_s\": {\"cpu\": ", "\"rounds\": 2",
+                          "\"cpu_over_opencv_baseline_range\": {\"1\": \""}) {
+    EXPECT_NE(r.output.find(key), std::string::npos) << key << " in " << r.output;
+  }
+  EXPECT_EQ(r.output.find("\"cpu\": null"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\"opencv_baseline\": null"), std::string::npos) << r.output;
+  r = gtrack("bench --rounds 0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--rounds must be in 1-100"), std::string::npos) << r.output;
   r = gtrack("track -c " + (fs::path(GTRACK_TEST_SOURCE_DIR) / "configs" / "microscope_hydrogel.toml").string() +
              " -i frames --stimulus-column B_mT --out " + out.string());
   EXPECT_EQ(r.code, 2);
