@@ -91,6 +91,32 @@ TEST(Cost, APluginErrorDuringABatchLeavesNoBatchPending) {
   EXPECT_EQ(t.size(), 2u);
 }
 
+// A gripper plugin's K that is no number is its error, named, not a cost
+// of nan that no comparison would ever take or refuse.
+TEST(Cost, AGripperPenaltyThatIsNoNumberIsThePluginsError) {
+  struct NanGripper final : gtrack::Gripper {
+    FixedGripper shape;
+    const gtrack::ArticulatedModel& model() const override { return shape.model(); }
+    double kinematic_penalty(std::span<const double> q) const override { return q[0] > 80 ? std::nan("") : 0.0; }
+  };
+  CountsRenderer r;
+  r.counts = {{10, 10}, {10, 10}};
+  NanGripper g;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, gtrack::CostWeights{});
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  std::vector<gtrack::CostTerms> t;
+  EXPECT_NO_THROW(eval.evaluate(h, t));
+  h(6, 1) = 85;
+  try {
+    eval.evaluate(h, t);
+    ADD_FAILURE() << "a penalty of nan was taken";
+  } catch (const gtrack::PluginError& e) {
+    EXPECT_STREQ(e.what(), "the gripper plugin's kinematic_penalty() returned nan for the joints [85, 0] deg; "
+                           "expected a finite number (0 for a plausible configuration)");
+  }
+  EXPECT_EQ(r.finished, r.submitted);
+}
+
 TEST(Cost, DiceDistanceFromCounts) {
   EXPECT_DOUBLE_EQ(gtrack::dice_distance(100, 100, 100), 0.0);  // identical
   EXPECT_DOUBLE_EQ(gtrack::dice_distance(0, 100, 50), 1.0);     // disjoint

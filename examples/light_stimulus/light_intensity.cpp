@@ -12,6 +12,7 @@
 // `trend_threshold_mW_cm2_per_s`), most particles start more folded.
 #include <algorithm>
 #include <cmath>
+#include <gtrack/error.hpp>
 #include <gtrack/plugin.hpp>
 
 namespace {
@@ -32,7 +33,10 @@ class LightIntensity final : public gtrack::Stimulus {
   }
 
   void update(double value, double time_s) override {
-    if (!std::isfinite(value)) return;
+    if (!std::isfinite(value) || value < 0) {
+      throw gtrack::Error("light_intensity: a reading of " + std::to_string(value) +
+                          " mW/cm2; expected a finite intensity, 0 or more");
+    }
     rate_ = have_ && time_s > t_ ? (value - value_) / (time_s - t_) : 0.0;
     const int region = value >= fold_above_ ? 1 : value <= unfold_below_ ? -1 : 0;
     // A log that starts outside the band starts settled.

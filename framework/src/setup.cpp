@@ -53,6 +53,20 @@ void warn_on_scale_mismatch(const ConfigTable& root, const Sensor& sensor, const
 // image_size(): a sensor plugin whose two differ (its projection's size left
 // unset) would render nothing the frames show.
 void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
+  // The numbers the engine builds on (the search box, the model's scale):
+  // one that is not finite would surface as a config key the file lacks.
+  const Projection projection = sensor.projection();
+  const auto refuse = [&](const std::string& what) {
+    table.fail("plugin", "the sensor plugin's " + what + "; expected finite numbers");
+  };
+  if (!projection.world_to_image.allFinite()) refuse("projection() holds a world_to_image that is not finite");
+  for (const auto& plane : projection.clip_planes) {
+    if (!plane.allFinite()) refuse("projection() holds a clip plane that is not finite");
+  }
+  if (!sensor.nominal_position_mm().allFinite()) refuse("nominal_position_mm() is not finite");
+  if (const double mm = sensor.mm_per_pixel(); !(std::isfinite(mm) && mm > 0)) {
+    refuse(fmt::format("mm_per_pixel() is {}, not a positive number", mm));
+  }
   const ImageSize image = sensor.image_size();
   const ImageSize drawn = sensor.projection().size;
   if (image.width <= 0 || image.height <= 0 || drawn.width != image.width || drawn.height != image.height) {

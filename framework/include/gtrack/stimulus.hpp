@@ -4,6 +4,19 @@
 // the reading(s) of that frame, in order. From its state the plugin supplies
 // S(H), the penalty for joint values the stimulus makes infeasible, and the
 // bias of the swarm's initial joint values.
+//
+// The contract (docs/plugins.md, "Writing a plugin"):
+// - Readings are in the plugin's own unit (reading_unit()), as the lab's
+//   log has them. update() throws (gtrack::Error, or a standard exception,
+//   with a one-line message) for a reading it cannot take: not finite, out
+//   of its range, a change faster than the material allows. gtrack checks
+//   every log row with it before tracking and names the row.
+// - All calls to an instance come from one thread, in frame order.
+// - The state is a function of the readings and times fed so far: --resume
+//   and --two-pass rebuild it by feeding them again to a new instance, so
+//   update() must not depend on the wall clock, randomness or globals.
+// - state(), penalty(), fold_fraction() and target_joint_deg() return
+//   finite numbers; a result that is not is refused as the plugin's error.
 #pragma once
 
 #include <span>

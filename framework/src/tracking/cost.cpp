@@ -6,6 +6,7 @@
 #include <span>
 
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 
 namespace gtrack {
 
@@ -83,6 +84,13 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
       const int joints = static_cast<int>(hypotheses.rows()) - kPoseDims;
       std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
       out[i].kinematic = gripper_->kinematic_penalty(q);
+      if (!std::isfinite(out[i].kinematic)) {
+        std::string joints;
+        for (double v : q) joints += (joints.empty() ? "" : ", ") + fmt::format("{:g}", v);
+        throw PluginError(fmt::format("the gripper plugin's kinematic_penalty() returned {} for the joints [{}] "
+                                      "deg; expected a finite number (0 for a plausible configuration)",
+                                      out[i].kinematic, joints));
+      }
       out[i].stimulus = stimulus_ ? stimulus_->penalty(q) : 0.0;
       out[i].coherence = joint_coherence(q, weights_.coherence_sigma_deg);
       out[i].temporal = (prediction_.size() > 0 && weights_.temporal > 0)

@@ -923,7 +923,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       const bool resumable = !options.follow_stimulus && options.input.rfind("camera:", 0) != 0;
       kept = fmt::format("; the {} frame{} before it {} kept in {}{}", done, done == 1 ? "" : "s",
                          done == 1 ? "is" : "are", options.out_dir.string(),
-                         resumable ? " (--resume goes on once the cause is mended)" : "");
+                         resumable ? " (--resume goes on once the cause is mended; a changed config or plugin "
+                                     "needs a new run)"
+                                   : "");
     } catch (const std::exception&) {
       // The error that stopped the run is the one to report.
     }
