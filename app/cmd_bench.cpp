@@ -94,6 +94,9 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   Backend cpu1{try_make(gtrack::make_cpu_renderer, 1, why)}, cpu_all{try_make(gtrack::make_cpu_renderer, all, why)},
       base1{try_make(gtrack::make_opencv_baseline, 1, why)}, base_all{try_make(gtrack::make_opencv_baseline, all, why)},
       gl;
+  for (const Backend* b : {&cpu1, &cpu_all, &base1, &base_all}) {
+    if (!b->renderer) throw gtrack::Error("bench: " + why);
+  }
   gl.renderer = try_make(gtrack::make_gl_renderer, 0, gl.why);
   cpu_all.frames = gl.frames = true;
   std::vector<double> ratio1, ratio_n;
@@ -104,7 +107,10 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
         b->hyp.push_back(gtrack::measure_hypotheses(*b->renderer, scene, slice, batch).per_second);
         if (b->frames) b->fps.push_back(gtrack::measure_pso_frames(*b->renderer, scene, slice).per_second);
       } catch (const gtrack::Error& e) {
-        b->why = e.what();  // (the gl backend failing part way: the others go on)
+        // The gl backend failing part way (a lost context): the others go
+        // on. The cpu and OpenCV backends have nothing to fail on.
+        if (b != &gl) throw;
+        b->why = e.what();
         b->renderer.reset();
         b->hyp.clear();
         b->fps.clear();

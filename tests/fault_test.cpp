@@ -701,6 +701,26 @@ TEST(Fault, AFollowedFolderWrittenUnderATemporaryNameTracksEveryImage) {
   EXPECT_NE(said.find("incoming.png: gone before it could be read whole"), std::string::npos) << said;
 }
 
+// One of a followed folder's numbered images removed before it was read
+// (a camera's ring buffer): its frame is left out, with a warning, and the
+// frames after it keep their numbers. (The reader holds at most two frames
+// ahead of the tracker: frame 4 is not read while frame 1 is tracked.)
+TEST(Fault, ANumberedImageGoneBeforeItWasReadLeavesItsFrameOut) {
+  const fs::path dir = fresh_dir("follow_vanished");
+  const TrackRun r = make_run();
+  const fs::path live = write_frames(dir / "live", 7);
+  gtrack::TrackOptions o = followed_run(live, dir, 0.5);
+  o.on_frame = [&](const gtrack::Estimate& e) {
+    if (e.frame == 1) fs::remove(live / "000004.png");
+  };
+  gtrack::TrackSummary s;
+  const std::string said = gtrack::testing::logged([&] { s = gtrack::track_sequence(r.setup, r.config, o); });
+  EXPECT_EQ(valid_rows(o.out_dir / "estimates.csv"), (std::vector<int>{0, 1, 2, 3, 5, 6}));
+  EXPECT_NE(said.find("000004.png: gone before it could be read (removed or moved away); frame 4 is left out"),
+            std::string::npos)
+      << said;
+}
+
 // Following a folder with --frames A:B: once frame B - 1 is taken there is
 // nothing left to wait for, and the run ends then, not --follow-input's
 // seconds later.

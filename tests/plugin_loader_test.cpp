@@ -205,8 +205,8 @@ TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {
   // Numbers the engine builds its search on that are not finite: the
   // plugin is named, not a key of the search box the config lacks.
   for (const auto& [key, said] : std::vector<std::pair<std::string, std::string>>{
-           {"nan = \"mm_per_pixel\"", "the sensor plugin's mm_per_pixel() is nan, not a positive number"},
-           {"mm_per_pixel = 0.0", "the sensor plugin's mm_per_pixel() is 0, not a positive number"},
+           {"nan = \"mm_per_pixel\"", "the sensor plugin's mm_per_pixel() is nan; expected a positive number"},
+           {"mm_per_pixel = 0.0", "the sensor plugin's mm_per_pixel() is 0; expected a positive number"},
            {"nan = \"nominal_position\"", "the sensor plugin's nominal_position_mm() is not finite"},
            {"nan = \"projection\"", "the sensor plugin's projection() holds a world_to_image that is not finite"}}) {
     try {

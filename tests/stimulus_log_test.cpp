@@ -192,14 +192,19 @@ TEST(StimulusLog, FollowTakesAppendedWholeLines) {
   ASSERT_TRUE(log.latest());
   EXPECT_DOUBLE_EQ(*log.latest(), 22.5);
   EXPECT_FALSE(log.poll());  // nothing whole since
-  // The last row's age: from when it was read, until a new row comes.
+  // The last row's age: from when it was read, until a new row comes; and
+  // the time between the polls that took rows.
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
   ASSERT_TRUE(log.latest_age_s());
-  EXPECT_GE(*log.latest_age_s(), 0.06);
+  const double before = *log.latest_age_s();
+  EXPECT_GE(before, 0.06);
+  EXPECT_FALSE(log.typical_row_gap_s());
   append("3.0\n");
   EXPECT_TRUE(log.poll());
   EXPECT_DOUBLE_EQ(*log.latest(), 23.0);
-  EXPECT_LT(*log.latest_age_s(), 0.06);
+  EXPECT_LT(*log.latest_age_s(), before);
+  ASSERT_TRUE(log.typical_row_gap_s());
+  EXPECT_GE(*log.typical_row_gap_s(), 0.06);
   EXPECT_FALSE(StimulusLog::parse("frame,value\n0,1\n").latest_age_s());  // a finished log has no age
   EXPECT_EQ(log.rows(), 2u);
   // A garbled row and one whose key steps back are said and left out: a

@@ -1202,10 +1202,13 @@ TEST(Tracker, UnseenFingersTakeTheSeenFingersFold) {
   gtrack::Tracker resumed(setup, on_tracker->config());
   resumed.restore(gtrack::parse_tracker_state(
       [&] {
-        const auto file = std::filesystem::temp_directory_path() / "gtrack_reported_state.txt";
+        const auto file = std::filesystem::temp_directory_path() /
+                          ("gtrack_reported_state_" + std::to_string(::getpid()) + ".txt");
         gtrack::write_tracker_state(file, on_tracker->state());
         std::ifstream in(file);
-        return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::filesystem::remove(file);
+        return text;
       }(),
       "state"));
   for (gtrack::Tracker* t : {on_tracker.get(), &resumed}) {

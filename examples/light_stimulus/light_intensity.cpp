@@ -33,10 +33,8 @@ class LightIntensity final : public gtrack::Stimulus {
   }
 
   void update(double value, double time_s) override {
-    if (!std::isfinite(value) || value < 0) {
-      throw gtrack::Error("light_intensity: a reading of " + std::to_string(value) +
-                          " mW/cm2; expected a finite intensity, 0 or more");
-    }
+    // (A photodiode's dark offset, a little below 0, is a reading.)
+    if (!std::isfinite(value)) throw gtrack::Error("light_intensity: a reading that is not a number; expected mW/cm2");
     rate_ = have_ && time_s > t_ ? (value - value_) / (time_s - t_) : 0.0;
     const int region = value >= fold_above_ ? 1 : value <= unfold_below_ ? -1 : 0;
     // A log that starts outside the band starts settled.

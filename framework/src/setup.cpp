@@ -56,19 +56,21 @@ void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
   // The numbers the engine builds on (the search box, the model's scale):
   // one that is not finite would surface as a config key the file lacks.
   const Projection projection = sensor.projection();
-  const auto refuse = [&](const std::string& what) {
-    table.fail("plugin", "the sensor plugin's " + what + "; expected finite numbers");
+  const auto refuse = [&](const std::string& what, const char* expected) {
+    table.fail("plugin", "the sensor plugin's " + what + "; expected " + expected);
   };
-  if (!projection.world_to_image.allFinite()) refuse("projection() holds a world_to_image that is not finite");
-  for (const auto& plane : projection.clip_planes) {
-    if (!plane.allFinite()) refuse("projection() holds a clip plane that is not finite");
+  if (!projection.world_to_image.allFinite()) {
+    refuse("projection() holds a world_to_image that is not finite", "finite numbers");
   }
-  if (!sensor.nominal_position_mm().allFinite()) refuse("nominal_position_mm() is not finite");
+  for (const auto& plane : projection.clip_planes) {
+    if (!plane.allFinite()) refuse("projection() holds a clip plane that is not finite", "finite numbers");
+  }
+  if (!sensor.nominal_position_mm().allFinite()) refuse("nominal_position_mm() is not finite", "finite numbers");
   if (const double mm = sensor.mm_per_pixel(); !(std::isfinite(mm) && mm > 0)) {
-    refuse(fmt::format("mm_per_pixel() is {}, not a positive number", mm));
+    refuse(fmt::format("mm_per_pixel() is {}", mm), "a positive number of millimetres");
   }
   const ImageSize image = sensor.image_size();
-  const ImageSize drawn = sensor.projection().size;
+  const ImageSize drawn = projection.size;
   if (image.width <= 0 || image.height <= 0 || drawn.width != image.width || drawn.height != image.height) {
     table.fail("plugin", "the sensor's projection().size is " + std::to_string(drawn.width) + "x" +
                              std::to_string(drawn.height) + " and its image_size() " + std::to_string(image.width) +

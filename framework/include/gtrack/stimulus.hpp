@@ -9,14 +9,17 @@
 // - Readings are in the plugin's own unit (reading_unit()), as the lab's
 //   log has them. update() throws (gtrack::Error, or a standard exception,
 //   with a one-line message) for a reading it cannot take: not finite, out
-//   of its range, a change faster than the material allows. gtrack checks
-//   every log row with it before tracking and names the row.
+//   of its range, a change faster than the material allows; and when it
+//   throws, leaves its state as it was. gtrack checks a finished log's
+//   every row with it before tracking and names the row; a followed log's
+//   rows as they come, leaving out one refused after others were taken.
 // - All calls to an instance come from one thread, in frame order.
 // - The state is a function of the readings and times fed so far: --resume
 //   and --two-pass rebuild it by feeding them again to a new instance, so
 //   update() must not depend on the wall clock, randomness or globals.
-// - state(), penalty(), fold_fraction() and target_joint_deg() return
-//   finite numbers; a result that is not is refused as the plugin's error.
+// - state(), penalty() (0 or more), fold_fraction() and target_joint_deg()
+//   return finite numbers; a result that is not is refused as the plugin's
+//   error.
 #pragma once
 
 #include <span>

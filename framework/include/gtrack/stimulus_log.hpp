@@ -57,6 +57,9 @@ class GTRACK_API StimulusLog {
   // follow(): seconds since the last row was read (poll() that took it),
   // on this machine's steady clock; nullopt while there is none.
   std::optional<double> latest_age_s() const;
+  // follow(): the median time between the polls that took new rows (of the
+  // last 15): how often the logger writes; nullopt before two have.
+  std::optional<double> typical_row_gap_s() const;
   // follow(): the rows left out, malformed or refused.
   int skipped_rows() const { return skipped_rows_; }
 
@@ -98,8 +101,9 @@ class GTRACK_API StimulusLog {
   std::streamoff read_to_ = 0;           // follow(): bytes taken (whole lines)
   bool gone_ = false;                    // follow(): the file is missing, and that was said
   bool refused_ = false;                 // the last row was refused by the check (not malformed)
-  int skipped_rows_ = 0;                 // follow(): malformed rows left out
+  int skipped_rows_ = 0;                 // follow(): rows left out, malformed or refused
   std::chrono::steady_clock::time_point latest_at_;  // follow(): when the last row was read
+  std::vector<double> row_gaps_s_;                   // follow(): the last times between rows read
   // follow(): the bytes just before read_to_, which the file (or one put in
   // its place) must still hold.
   std::string tail_;

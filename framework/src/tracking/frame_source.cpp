@@ -402,11 +402,21 @@ class FolderSource final : public FrameSource {
         f.name = p.string();
         cv::Mat image = read(p);
         if (vanished_) {
-          // Renamed or removed before it was whole (a camera's software that
-          // writes under a temporary name and renames): no frame. Its name
-          // stays known, so a temporary name used again is not listed again.
-          logger().info("{}: gone before it could be read whole (renamed or removed); not a frame", p.string());
           vanished_ = false;
+          // One of the numbered images (a camera's ring buffer, a file moved
+          // away): its frame is left out, the frames after it keep their
+          // numbers. Any other name (a camera's software that writes under a
+          // temporary name and renames): no frame, and its name stays known,
+          // so that the temporary name used again is not listed again.
+          const size_t at = static_cast<size_t>(i);
+          const bool numbered = (at > 0 && numbered_next(files_[at - 1], p) >= 0) ||
+                                (at + 1 < files_.size() && numbered_next(p, files_[at + 1]) >= 0);
+          if (numbered) {
+            logger().warn("{}: gone before it could be read (removed or moved away); frame {} is left out", p.string(),
+                          i);
+            continue;
+          }
+          logger().info("{}: gone before it could be read whole (renamed or removed); not a frame", p.string());
           files_.erase(files_.begin() + i);
           index_ = i;
           continue;
@@ -454,7 +464,8 @@ class FolderSource final : public FrameSource {
   }
 
   // The folder's images in name order. Following, scan() runs once every
-  // image listed so far was taken: an image that arrives late, named before
+  // image listed so far was taken (with --newest, before every frame): an
+  // image that arrives late, named before
   // the last one taken, is not tracked (the frame numbers of what was taken
   // never change) and is warned about.
   void scan() {

@@ -262,7 +262,14 @@ bool StimulusLog::poll() {
   read_to_ += static_cast<std::streamoff>(end + 1);
   tail_ = (tail_ + fresh.substr(0, end + 1));
   if (tail_.size() > 256) tail_.erase(0, tail_.size() - 256);
-  if (keys_.size() > rows_before) latest_at_ = std::chrono::steady_clock::now();
+  if (keys_.size() > rows_before) {
+    const auto now = std::chrono::steady_clock::now();
+    if (rows_before > 0) {
+      row_gaps_s_.push_back(std::chrono::duration<double>(now - latest_at_).count());
+      if (row_gaps_s_.size() > 15) row_gaps_s_.erase(row_gaps_s_.begin());
+    }
+    latest_at_ = now;
+  }
   return keys_.size() > rows_before;
 }
 
@@ -281,6 +288,13 @@ void StimulusLog::shift_time(double seconds) {
 std::optional<double> StimulusLog::latest() const {
   if (values_.empty()) return std::nullopt;
   return values_.back();
+}
+
+std::optional<double> StimulusLog::typical_row_gap_s() const {
+  if (row_gaps_s_.empty()) return std::nullopt;
+  std::vector<double> gaps = row_gaps_s_;
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  return gaps[gaps.size() / 2];
 }
 
 std::optional<double> StimulusLog::latest_age_s() const {

@@ -174,7 +174,7 @@ int expected_frames(const FrameSource& src, const FrameRange& r) {
 
 // How a log's times are shown when --stimulus-offset moved them.
 std::string shifted_by(const StimulusLog& log) {
-  return log.time_shift() != 0 ? fmt::format(" (its time_s less --stimulus-offset {:g})", log.time_shift()) : "";
+  return log.time_shift() != 0 ? fmt::format(" (its time_s less --stimulus-offset {})", log.time_shift()) : "";
 }
 
 // A time_s log whose times start more than a day after a frame's: seconds
@@ -639,7 +639,9 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // The reading of a frame: the log's, or its nearest past the log's ends.
   bool warned_range = false;
   // A followed log that stops growing (a logger that hung): said once
-  // while it stays so, the frames holding its last reading.
+  // while it stays so, the frames holding its last reading. Stale: no row
+  // for 5 s, or for three times the logger's usual interval if longer (one
+  // that writes every 10 s is not stale between its rows).
   constexpr double kStaleLogS = 5;
   bool said_stale = false;
   std::optional<double> reading_age;  // of the last reading_at(), followed
@@ -648,12 +650,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     if (options.follow_stimulus) {
       log->poll();
       reading_age = log->latest_age_s();
-      if (reading_age && *reading_age > kStaleLogS && !said_stale) {
+      const double stale_after = std::max(kStaleLogS, 3 * log->typical_row_gap_s().value_or(0));
+      if (reading_age && *reading_age > stale_after && !said_stale) {
         logger().warn("{}: the followed stimulus log has had no new row for {:.1f} s (frame {}); the frames hold its "
                       "last reading, {:g}, and estimates.jsonl gives its age (stimulus_age_s)",
                       log->source(), *reading_age, index, *log->latest());
         said_stale = true;
-      } else if (reading_age && *reading_age <= kStaleLogS && said_stale) {
+      } else if (reading_age && *reading_age <= stale_after && said_stale) {
         logger().info("{}: the followed stimulus log has new rows again (frame {})", log->source(), index);
         said_stale = false;
       }

@@ -53,7 +53,7 @@ struct Tracker::Impl {
   // own; one mask a frame, and only while the model reaches a border).
   std::unique_ptr<Renderer> whole_view;
   // The previous estimate's mask, once a frame: drawn on the CPU when the
-  // search renders elsewhere (a GPU), where reading one mask back would
+  // search renders on the gl backend, where reading one mask back would
   // stall the pipeline every frame for a few thousand pixels.
   std::unique_ptr<Renderer> mask_view;
   Renderer& masks() { return mask_view ? *mask_view : *renderer; }
@@ -104,7 +104,7 @@ struct Tracker::Impl {
     whole.threads = 1;
     whole_view = make_cpu_renderer(whole);
     whole_view->set_model(setup.model());
-    if (renderer->name() != "cpu") {
+    if (renderer->name() == "gl") {
       mask_view = make_cpu_renderer(whole);
       mask_view->set_model(setup.model());
       mask_view->set_projection(projection, config.render.scale);
