@@ -10,7 +10,10 @@
 #include <gtest/gtest.h>
 #include <gtrack/error.hpp>
 #include <gtrack/log.hpp>
+#include <gtrack/engine_config.hpp>
 #include <gtrack/renderer.hpp>
+#include <gtrack/setup.hpp>
+#include <gtrack/tracker.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -838,6 +841,51 @@ TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndLineOfTheError) {
       EXPECT_NE(m.find("error"), std::string::npos) << m;
       EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     }
+  }
+}
+
+// A tracker on the gl backend (its previous estimate's mask drawn on the
+// CPU, its hypotheses on the GPU) follows a moving gripper as the cpu
+// backend's does.
+TEST(GlRenderer, ATrackerOnTheGlBackendFollowsTheGripperAsTheCpuOneDoes) {
+  GL_OR_SKIP(gl);
+  const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(R"(
+[sensor]
+plugin = "pinhole_microscope"
+width = 256
+height = 256
+fx = 3200.0
+working_distance_mm = 100.0
+[gripper]
+plugin = "hydrogel_six_finger"
+[render]
+scale = 0.5
+[search]
+position_min_mm = [-3.0, -3.0, 98.0]
+position_max_mm = [3.0, 3.0, 102.0]
+)",
+                                                                              "<test>"),
+                                                 {});
+  const gtrack::EngineConfig config = gtrack::engine_config(setup);
+  auto cpu = make_cpu();
+  cpu->set_model(setup.model());
+  cpu->set_projection(setup.sensor->projection(), 1.0);
+  const auto truth = [](int i) {
+    Eigen::VectorXd h(12);
+    h << 0.2 + 0.04 * i, -0.1 + 0.02 * i, 100, 8, -5, 20 + 2 * i, 10, 12, 14, 10, 12, 14;
+    return h;
+  };
+  gtrack::Tracker on_gl(setup, config, std::move(gl));
+  gtrack::Tracker on_cpu(setup, config, make_cpu());
+  for (int i = 0; i < 4; ++i) {
+    const cv::Mat mask = cpu->render_mask(truth(i));
+    cv::Mat image(mask.size(), CV_8UC3, cv::Scalar(120, 125, 130));
+    image.setTo(cv::Scalar(60, 70, 200), mask);
+    const gtrack::Estimate g = on_gl.process(image, i, i / 30.0, std::nullopt);
+    const gtrack::Estimate c = on_cpu.process(image, i, i / 30.0, std::nullopt);
+    EXPECT_NE(g.status, gtrack::TrackStatus::Lost) << "frame " << i;
+    EXPECT_LT((g.hypothesis.head<2>() - truth(i).head<2>()).norm(), 0.05) << "frame " << i;
+    EXPECT_LT((g.hypothesis.head<2>() - c.hypothesis.head<2>()).norm(), 0.05) << "frame " << i;
   }
 }
 
