@@ -22,6 +22,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "gtrack/model.hpp"
+#include "support/scoped_env.hpp"
 
 namespace fs = std::filesystem;
 
@@ -43,28 +44,9 @@ CliRun gtrack(const std::string& args, const std::string& redirect = "2>&1") {
 }
 
 // A gtrack run that starts the gl backend goes without LeakSanitizer's
-// check: Mesa's driver is unloaded before the check runs at exit, and its
-// allocations then show as leaks that no suppression can name (as for the
-// gl tests in scripts/ci_sanitize.sh). Without the sanitizers the option is
-// not read.
-class NoLeakCheckForGl {
- public:
-  NoLeakCheckForGl() {
-    if (const char* old = std::getenv("ASAN_OPTIONS")) old_ = old;
-    ::setenv("ASAN_OPTIONS", (old_ ? *old_ + ":" : std::string()).append("detect_leaks=0").c_str(), 1);
-  }
-  ~NoLeakCheckForGl() {
-    if (old_) {
-      ::setenv("ASAN_OPTIONS", old_->c_str(), 1);
-    } else {
-      ::unsetenv("ASAN_OPTIONS");
-    }
-  }
-  NoLeakCheckForGl(const NoLeakCheckForGl&) = delete;
-  NoLeakCheckForGl& operator=(const NoLeakCheckForGl&) = delete;
-
- private:
-  std::optional<std::string> old_;
+// check (see asan_options_without_leak_check).
+struct NoLeakCheckForGl : gtrack::testing::ScopedEnv {
+  NoLeakCheckForGl() : ScopedEnv("ASAN_OPTIONS", gtrack::testing::asan_options_without_leak_check()) {}
 };
 
 fs::path write(const std::string& name, const std::string& text) {
@@ -236,12 +218,14 @@ TEST(Cli, ARendererThatCannotStartIsSaidBeforeTheFirstImage) {
   fs::remove_all(dir);
   ASSERT_EQ(gtrack("synth --frames 1 --seed 2 --out " + dir.string()).code, 0);
   fs::create_directories(dir / "empty");
-  ::setenv("GTRACK_GL_COUNT_ROWS", "0", 1);
-  const NoLeakCheckForGl gl_run;
   const auto start = std::chrono::steady_clock::now();
-  const CliRun r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "empty").string() +
-                          " -o " + (dir / "out").string() + " --backend gl --follow-input 60");
-  ::unsetenv("GTRACK_GL_COUNT_ROWS");
+  CliRun r{};
+  {
+    const gtrack::testing::ScopedEnv no_rows("GTRACK_GL_COUNT_ROWS", "0");
+    const NoLeakCheckForGl gl_run;
+    r = gtrack("track -c " + (dir / "sequence.toml").string() + " -i " + (dir / "empty").string() + " -o " +
+               (dir / "out").string() + " --backend gl --follow-input 60");
+  }
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 30.0);
   EXPECT_EQ(r.code, 1) << r.output;
   // (The count's setting where the gl backend starts, else why it cannot.)

@@ -35,7 +35,9 @@
 #include <vector>
 
 #include "support/logged.hpp"
+#include "support/plugins.hpp"
 #include "support/reference_raster.hpp"
+#include "support/scoped_env.hpp"
 
 namespace {
 
@@ -48,31 +50,10 @@ using gtrack::Renderer;
 using gtrack::testing::hydrogel_geometry;
 using gtrack::testing::microscope_projection;
 using gtrack::testing::reference_mask;
+using gtrack::testing::ScopedEnv;
 
 constexpr double kScale = 0.25;
 constexpr char kNoContext[] = "gl backend: no EGL context";
-
-// Sets an environment variable for the scope and restores it after.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_) {
-      setenv(name_, old_->c_str(), 1);
-    } else {
-      unsetenv(name_);
-    }
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
 
 // The renderer, or the reason there is no EGL context on this machine.
 std::unique_ptr<Renderer> make_gl(std::string& skip, const RenderOptions& options = {}) {
@@ -849,23 +830,7 @@ TEST_F(ShaderFolder, ACompileErrorNamesTheFileAndLineOfTheError) {
 // backend's does.
 TEST(GlRenderer, ATrackerOnTheGlBackendFollowsTheGripperAsTheCpuOneDoes) {
   GL_OR_SKIP(gl);
-  const gtrack::Setup setup = gtrack::load_setup(gtrack::ConfigTable::parse(R"(
-[sensor]
-plugin = "pinhole_microscope"
-width = 256
-height = 256
-fx = 3200.0
-working_distance_mm = 100.0
-[gripper]
-plugin = "hydrogel_six_finger"
-[render]
-scale = 0.5
-[search]
-position_min_mm = [-3.0, -3.0, 98.0]
-position_max_mm = [3.0, 3.0, 102.0]
-)",
-                                                                              "<test>"),
-                                                 {});
+  const gtrack::Setup setup = gtrack::testing::small_microscope_setup();
   const gtrack::EngineConfig config = gtrack::engine_config(setup);
   auto cpu = make_cpu();
   cpu->set_model(setup.model());

@@ -6,11 +6,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <vector>
 #include <gtrack/error.hpp>
 #include <gtrack/plugin_loader.hpp>
 #include <gtrack/setup.hpp>
 
 #include "support/logged.hpp"
+#include "support/scoped_env.hpp"
 
 namespace fs = std::filesystem;
 
@@ -247,11 +250,13 @@ TEST(PluginLoader, InstanceKeepsItsLibraryLoaded) {
 }
 
 TEST(PluginLoader, SearchOrderPutsUserPathsFirst) {
-  ::setenv("GTRACK_PLUGIN_PATH", "/env/a:/env/b", 1);
-  gtrack::PluginLoader loader({"/user/1"});
-  loader.add_path("/config/2");
-  ::unsetenv("GTRACK_PLUGIN_PATH");
-  const auto& p = loader.search_paths();
+  std::optional<gtrack::PluginLoader> loader;
+  {
+    const gtrack::testing::ScopedEnv env("GTRACK_PLUGIN_PATH", "/env/a:/env/b");
+    loader.emplace(std::vector<fs::path>{"/user/1"});
+  }
+  loader->add_path("/config/2");
+  const auto& p = loader->search_paths();
   ASSERT_EQ(p.size(), 5u);
   EXPECT_EQ(p[0], "/user/1");
   EXPECT_EQ(p[1], "/config/2");

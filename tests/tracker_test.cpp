@@ -31,30 +31,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// 256x256 microscope: the 4 mm gripper is ~128 px across at 100 mm.
-const char* kConfig = R"(
-[sensor]
-plugin = "pinhole_microscope"
-width = 256
-height = 256
-fx = 3200.0
-working_distance_mm = 100.0
-[gripper]
-plugin = "hydrogel_six_finger"
-[stimulus]
-plugin = "temperature_hysteresis"
-[render]
-backend = "cpu"
-scale = 0.5
-threads = 2
-[search]
-position_min_mm = [-3.0, -3.0, 98.0]
-position_max_mm = [3.0, 3.0, 102.0]
-)";
+const char* const kConfig = gtrack::testing::kSmallMicroscopeConfig;
 
-gtrack::Setup make_setup(const std::string& extra = "") {
-  return gtrack::load_setup(gtrack::ConfigTable::parse(std::string(kConfig) + extra, "<test>"), {});
-}
+gtrack::Setup make_setup(const std::string& extra = "") { return gtrack::testing::small_microscope_setup(extra); }
 
 // The message of the ConfigError that engine_config raises for the test
 // config plus `extra` (a test failure, and "", when it raises none).

@@ -36,4 +36,31 @@ inline Setup probe_setup(const std::string& rotation = "", const std::string& en
   return load_setup(ConfigTable::parse(text, "<test>"), {});
 }
 
+// A small microscope: 256x256, the 4 mm hydrogel gripper ~128 px across at
+// 100 mm, rendered at scale 0.5 on the cpu backend, searched within 3 mm.
+inline constexpr char kSmallMicroscopeConfig[] = R"(
+[sensor]
+plugin = "pinhole_microscope"
+width = 256
+height = 256
+fx = 3200.0
+working_distance_mm = 100.0
+[gripper]
+plugin = "hydrogel_six_finger"
+[stimulus]
+plugin = "temperature_hysteresis"
+[render]
+backend = "cpu"
+scale = 0.5
+threads = 2
+[search]
+position_min_mm = [-3.0, -3.0, 98.0]
+position_max_mm = [3.0, 3.0, 102.0]
+)";
+
+// That microscope's setup, with `extra` (TOML) added.
+inline Setup small_microscope_setup(const std::string& extra = "") {
+  return load_setup(ConfigTable::parse(std::string(kSmallMicroscopeConfig) + extra, "<test>"), {});
+}
+
 }  // namespace gtrack::testing

@@ -400,9 +400,8 @@ class FolderSource final : public FrameSource {
         f.index = i;
         f.time_s = fps_ > 0 ? i / fps_ : 0.0;
         f.name = p.string();
-        cv::Mat image = read(p);
-        if (vanished_) {
-          vanished_ = false;
+        const ReadImage got = read(p);
+        if (got.vanished) {
           // One of the numbered images (a camera's ring buffer, a file moved
           // away): its frame is left out, the frames after it keep their
           // numbers. Any other name (a camera's software that writes under a
@@ -421,15 +420,13 @@ class FolderSource final : public FrameSource {
           index_ = i;
           continue;
         }
-        if (image.empty()) return std::nullopt;  // cancelled while the image was still being written
-        f.image = to_bgr(image, f.name);
+        if (got.image.empty()) return std::nullopt;  // cancelled while the image was still being written
+        f.image = to_bgr(got.image, f.name);
         check_size(f.image, expected_, p.string());
         f.waited_s = waited_s_;
-        std::error_code ec;
-        const auto written = fs::last_write_time(p, ec);
-        if (!ec) {
+        if (got.written) {
           f.written_unix_s = std::chrono::duration<double>(
-                                 std::chrono::file_clock::to_sys(written).time_since_epoch())
+                                 std::chrono::file_clock::to_sys(*got.written).time_since_epoch())
                                  .count();
         }
         return f;
@@ -584,8 +581,14 @@ class FolderSource final : public FrameSource {
   // seconds, by its size or its file time,
   // with a warning naming it). A cancel while waiting returns an empty image.
   // The file is decoded again only once its size or file time has changed
-  // (a poll costs a stat, not a decode).
-  cv::Mat read(const fs::path& p) const {
+  // (a poll costs a stat, not a decode). The file time returned is the one
+  // of the poll that took the image.
+  struct ReadImage {
+    cv::Mat image;                              // empty: cancelled, or vanished
+    bool vanished = false;                      // the file went away before it was whole
+    std::optional<fs::file_time_type> written;  // its file time, when it could be read
+  };
+  ReadImage read(const fs::path& p) const {
     const auto decode = [&p](std::string& said) {
       detail::CapturedStderr library;
       cv::Mat img = cv::imread(p.string(), cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
@@ -594,10 +597,14 @@ class FolderSource final : public FrameSource {
     };
     std::string said;
     if (!following()) {
-      cv::Mat img = decode(said);
-      if (img.empty()) fail_to_read(p, said);
+      ReadImage got;
+      got.image = decode(said);
+      if (got.image.empty()) fail_to_read(p, said);
       if (!said.empty()) logger().debug("{}: the decoder said: {}", p.string(), said);
-      return img;
+      std::error_code ec;
+      const fs::file_time_type written = fs::last_write_time(p, ec);
+      if (!ec) got.written = written;
+      return got;
     }
     auto changed = std::chrono::steady_clock::now();
     std::uintmax_t last_size = static_cast<std::uintmax_t>(-1);
@@ -610,10 +617,7 @@ class FolderSource final : public FrameSource {
       std::error_code ec, ec_time, ec_exists;
       const std::uintmax_t size = fs::file_size(p, ec);
       const fs::file_time_type written = fs::last_write_time(p, ec_time);
-      if (ec && !fs::exists(p, ec_exists) && !ec_exists) {
-        vanished_ = true;
-        return {};
-      }
+      if (ec && !fs::exists(p, ec_exists) && !ec_exists) return {cv::Mat(), true, std::nullopt};
       // Also every 2 s: a writer that set the size first, on a file system
       // whose file times step by seconds, changes neither as it fills.
       if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time ||
@@ -641,7 +645,10 @@ class FolderSource final : public FrameSource {
           !growing && !ec_time && fs::file_time_type::clock::now() - written > std::chrono::seconds(2);
       if (!img.empty() && (said.empty() || settled || old)) {
         if (!said.empty()) logger().warn("{}: the decoder said: {}", p.string(), said);
-        return img;
+        ReadImage got;
+        got.image = img;
+        if (!ec_time) got.written = written;
+        return got;
       }
       // One that does not decode at all is waited on as long as a new image
       // would be (--follow-input's seconds, 2 s at least): a writer may pause
@@ -663,7 +670,6 @@ class FolderSource final : public FrameSource {
 
   fs::path dir_;
   mutable double waited_s_ = 0;  // of the frame being taken
-  mutable bool vanished_ = false;  // read(): the file went away before it was whole
   std::vector<fs::path> files_;
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
   bool warned_gap_ = false;

@@ -644,12 +644,16 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // that writes every 10 s is not stale between its rows).
   constexpr double kStaleLogS = 5;
   bool said_stale = false;
-  std::optional<double> reading_age;  // of the last reading_at(), followed
-  const auto reading_at = [&](int index, double time_s) -> std::optional<double> {
-    if (!log) return std::nullopt;
+  // A frame's reading, and for a followed log its age when read.
+  struct Reading {
+    std::optional<double> value;
+    std::optional<double> age_s;
+  };
+  const auto reading_at = [&](int index, double time_s) -> Reading {
+    if (!log) return {};
     if (options.follow_stimulus) {
       log->poll();
-      reading_age = log->latest_age_s();
+      const std::optional<double> reading_age = log->latest_age_s();
       const double stale_after = std::max(kStaleLogS, 3 * log->typical_row_gap_s().value_or(0));
       if (reading_age && *reading_age > stale_after && !said_stale) {
         logger().warn("{}: the followed stimulus log has had no new row for {:.1f} s (frame {}); the frames hold its "
@@ -660,7 +664,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         logger().info("{}: the followed stimulus log has new rows again (frame {})", log->source(), index);
         said_stale = false;
       }
-      return log->latest();
+      return {log->latest(), reading_age};
     }
     std::optional<double> reading = log->value_at(index, time_s);
     if (!reading) {
@@ -681,7 +685,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       }
       reading = log->nearest(index, time_s);
     }
-    return reading;
+    return {reading, std::nullopt};
   };
 
   // The tracker and its renderer are made before the first frame is waited
@@ -772,7 +776,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     // the frames already done, in order.
     for (const int index : done) {
       feed_untracked(index);
-      tracker.replay_stimulus(reading_at(index, index / fps), index / fps);
+      tracker.replay_stimulus(reading_at(index, index / fps).value, index / fps);
     }
     logger().info("resuming after frame {} ({} frames already in {})", resumed->frame, done.size(),
                   options.out_dir.string());
@@ -851,7 +855,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       double io_ms = std::max(0.0, read_s - frame->waited_s) * 1e3;
       const double time_s = frame->index / fps;
       feed_untracked(frame->index);
-      const std::optional<double> reading = reading_at(frame->index, time_s);
+      const Reading reading = reading_at(frame->index, time_s);
 
       if (!restart_rows.empty()) {
         const auto row = restart_rows.find(previous_index >= 0 ? previous_index : frame->index - range.every);
@@ -860,8 +864,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
           ++restarts_used;
         }
       }
-      Estimate e = tracker.process(frame->image, frame->index, time_s, reading);
-      if (options.follow_stimulus) e.stimulus_age_s = reading_age;
+      Estimate e = tracker.process(frame->image, frame->index, time_s, reading.value);
+      e.stimulus_age_s = reading.age_s;
       advice.after(*frame, e, tracker.last_observation(), summary.frames == 0);
       previous_index = frame->index;
       if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
