@@ -1,6 +1,7 @@
 // Paper eq. (1): D from the renderer's counts, K and S from the plugins, weights.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <vector>
 
 #include "gtrack/cost.hpp"
@@ -111,8 +112,38 @@ TEST(Cost, AGripperPenaltyThatIsNoNumberIsThePluginsError) {
     eval.evaluate(h, t);
     ADD_FAILURE() << "a penalty of nan was taken";
   } catch (const gtrack::PluginError& e) {
-    EXPECT_STREQ(e.what(), "the gripper plugin's kinematic_penalty() returned nan for the joints [85, 0] deg; "
+    EXPECT_STREQ(e.what(), "gripper plugin: kinematic_penalty() returned nan for the joints [85, 0] deg; "
                            "expected a finite number (0 for a plausible configuration)");
+  }
+  EXPECT_EQ(r.finished, r.submitted);
+}
+
+// A gripper plugin's own exception from kinematic_penalty() is its error,
+// naming it as the tracker labels it, and the renderers' batch is
+// collected all the same.
+TEST(Cost, AGripperPenaltyThatThrowsIsThePluginsErrorNamingIt) {
+  struct ThrowingGripper final : gtrack::Gripper {
+    FixedGripper shape;
+    const gtrack::ArticulatedModel& model() const override { return shape.model(); }
+    double kinematic_penalty(std::span<const double> q) const override {
+      if (q[1] > 80) throw std::out_of_range("joint 1 past the lookup table");
+      return 0.0;
+    }
+  };
+  CountsRenderer r;
+  r.counts = {{10, 10}, {10, 10}};
+  ThrowingGripper g;
+  gtrack::CostEvaluator eval({&r}, g, nullptr, gtrack::CostWeights{});
+  eval.set_gripper_label("gripper plugin 'lab_gripper' (/opt/lab/libgtrack_lab_gripper.so)");
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  h(7, 0) = 90;
+  std::vector<gtrack::CostTerms> t;
+  try {
+    eval.evaluate(h, t);
+    ADD_FAILURE() << "the plugin's exception was not seen";
+  } catch (const gtrack::PluginError& e) {
+    EXPECT_STREQ(e.what(), "gripper plugin 'lab_gripper' (/opt/lab/libgtrack_lab_gripper.so): kinematic_penalty() "
+                           "threw for the joints [0, 90] deg: joint 1 past the lookup table");
   }
   EXPECT_EQ(r.finished, r.submitted);
 }

@@ -13,6 +13,7 @@
 #include <gtrack/setup.hpp>
 
 #include "support/logged.hpp"
+#include "support/plugins.hpp"
 #include "support/scoped_env.hpp"
 
 namespace fs = std::filesystem;
@@ -60,7 +61,9 @@ TEST(PluginLoader, AStimulusPluginsUnusableResultsAreRefusedNamingIt) {
     return loader.make_stimulus(root.table("stimulus"));
   };
   const std::vector<double> joints{10, 20};
-  const std::string plugin = "stimulus plugin 'fixture_wrong_stimulus': ";
+  // Named with its file.
+  const std::string plugin = "stimulus plugin 'fixture_wrong_stimulus' (" +
+                             (kFixtures / "libgtrack_fixture_wrong_stimulus.so").string() + "): ";
   EXPECT_EQ(plugin_error([&] { made("nan_penalty")->penalty(joints); }),
             plugin + "penalty() returned nan; expected a finite number, 0 or more");
   EXPECT_EQ(plugin_error([&] { made("range_upside_down")->state(); }),
@@ -68,6 +71,9 @@ TEST(PluginLoader, AStimulusPluginsUnusableResultsAreRefusedNamingIt) {
                      "feasible_max_deg, neither nan");
   EXPECT_EQ(plugin_error([&] { made("fold_fraction")->fold_fraction(); }),
             plugin + "fold_fraction() returned 1.5; expected a number in [0, 1]");
+  // Its own exception, likewise.
+  EXPECT_EQ(plugin_error([&] { made("throws")->penalty(joints); }),
+            plugin + "penalty() threw: calibration table not loaded");
   const auto right = made("nothing");
   EXPECT_EQ(plugin_error([&] {
               right->update(3.5, 0.1);
@@ -293,3 +299,15 @@ TEST(PluginLoader, APluginThatSetsAnotherAsideIsSaidOnce) {
 }
 
 }  // namespace
+
+// A setup names each plugin it made with its file, as a run's errors do;
+// one its loader did not make is named by its kind only.
+TEST(PluginLoader, ASetupNamesItsPluginsWithTheirFiles) {
+  const gtrack::Setup setup = gtrack::testing::small_microscope_setup();
+  const std::string gripper = gtrack::plugin_label(setup, gtrack::PluginKind::Gripper);
+  EXPECT_EQ(gripper.rfind("gripper plugin 'hydrogel_six_finger' (", 0), 0u) << gripper;
+  EXPECT_NE(gripper.find("libgtrack_hydrogel_six_finger.so)"), std::string::npos) << gripper;
+  gtrack::Setup by_hand;
+  by_hand.gripper = setup.gripper;
+  EXPECT_EQ(gtrack::plugin_label(by_hand, gtrack::PluginKind::Gripper), "gripper plugin");
+}

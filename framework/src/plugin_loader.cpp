@@ -318,7 +318,9 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
   }
   logger().debug("loaded {} plugin '{}' {} from {}", to_string(kind), rec.name, rec.version, file.string());
   // A stimulus's results are checked as the tracker takes them.
-  if constexpr (std::is_same_v<Interface, Stimulus>) return std::make_shared<detail::CheckedStimulus>(instance, name);
+  if constexpr (std::is_same_v<Interface, Stimulus>) {
+    return std::make_shared<detail::CheckedStimulus>(instance, "stimulus plugin '" + name + "' (" + file.string() + ")");
+  }
   return instance;
 }
 

@@ -115,6 +115,15 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   return s;
 }
 
+std::string plugin_label(const Setup& setup, PluginKind kind) {
+  const std::string label = std::string(to_string(kind)) + " plugin";
+  if (!setup.loader) return label;
+  for (const PluginRecord& r : setup.loader->loaded()) {
+    if (r.kind == kind) return label + " '" + r.name + "' (" + r.file.string() + ")";
+  }
+  return label;
+}
+
 Setup load_setup(const fs::path& config_file, const SetupOptions& options) {
   // A run's copy of its config takes its relative paths from where the
   // original's were taken; a pipe's are taken from the working folder.

@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "gtrack/engine_config.hpp"
@@ -94,6 +96,8 @@ class GTRACK_API CostEvaluator {
   CostTerms evaluate_one(const Eigen::VectorXd& hypothesis);
 
   void set_stimulus(const Stimulus* stimulus) { stimulus_ = stimulus; }
+  // How the gripper plugin is named in its errors (plugin_label()).
+  void set_gripper_label(std::string label) { gripper_label_ = std::move(label); }
   // The temporal term (lambda_T * T): the predicted configuration and the
   // per-parameter scale. An empty prediction turns the term off.
   void set_prediction(Eigen::VectorXd prediction, Eigen::VectorXd sigma, bool wrap_rz) {
@@ -123,6 +127,7 @@ class GTRACK_API CostEvaluator {
  private:
   std::vector<Renderer*> renderers_;
   const Gripper* gripper_;
+  std::string gripper_label_ = "gripper plugin";
   const Stimulus* stimulus_;
   CostWeights weights_;
   std::vector<PairCounts> counts_;

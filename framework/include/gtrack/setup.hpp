@@ -42,4 +42,8 @@ struct SetupOptions {
 GTRACK_API Setup load_setup(const ConfigTable& root, const SetupOptions& options);
 GTRACK_API Setup load_setup(const std::filesystem::path& config_file, const SetupOptions& options);
 
+// The setup's plugin of `kind` as its errors name it: "gripper plugin
+// 'name' (file)"; "gripper plugin" for one its loader did not make.
+GTRACK_API std::string plugin_label(const Setup& setup, PluginKind kind);
+
 }  // namespace gtrack

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <span>
 
 #include "gtrack/error.hpp"
@@ -83,13 +84,23 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     for (int i = 0; i < n; ++i) {
       const int joints = static_cast<int>(hypotheses.rows()) - kPoseDims;
       std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
-      out[i].kinematic = gripper_->kinematic_penalty(q);
-      if (!std::isfinite(out[i].kinematic)) {
+      const auto joint_list = [&q] {
         std::string joints;
         for (double v : q) joints += (joints.empty() ? "" : ", ") + fmt::format("{:g}", v);
-        throw PluginError(fmt::format("the gripper plugin's kinematic_penalty() returned {} for the joints [{}] "
-                                      "deg; expected a finite number (0 for a plausible configuration)",
-                                      out[i].kinematic, joints));
+        return joints;
+      };
+      try {
+        out[i].kinematic = gripper_->kinematic_penalty(q);
+      } catch (const Error&) {
+        throw;
+      } catch (const std::exception& e) {
+        throw PluginError(fmt::format("{}: kinematic_penalty() threw for the joints [{}] deg: {}", gripper_label_,
+                                      joint_list(), e.what()));
+      }
+      if (!std::isfinite(out[i].kinematic)) {
+        throw PluginError(fmt::format("{}: kinematic_penalty() returned {} for the joints [{}] deg; expected a "
+                                      "finite number (0 for a plausible configuration)",
+                                      gripper_label_, out[i].kinematic, joint_list()));
       }
       out[i].stimulus = stimulus_ ? stimulus_->penalty(q) : 0.0;
       out[i].coherence = joint_coherence(q, weights_.coherence_sigma_deg);

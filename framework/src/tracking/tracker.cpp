@@ -117,6 +117,7 @@ struct Tracker::Impl {
     cost = std::make_unique<CostEvaluator>(std::vector<Renderer*>{renderer.get()}, *setup.gripper, nullptr,
                                            config.cost);
     cost->set_use_rim(config.cost.occlusion_rim_px > 0);
+    cost->set_gripper_label(plugin_label(setup, PluginKind::Gripper));
   }
 
   // Hands the current observation to the renderer, with its rim: the pixels
