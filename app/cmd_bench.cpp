@@ -27,7 +27,7 @@ constexpr double kGripperPx = 114;
 
 struct Measured {
   std::optional<double> value;
-  std::string note;  // why there is no value
+  std::string note = {};  // why there is no value
 };
 
 std::string json_number(const std::optional<double>& v) {
@@ -86,9 +86,9 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const double slice = seconds / rounds;
   struct Backend {
     std::unique_ptr<gtrack::Renderer> renderer;
-    std::string why;
+    std::string why = {};
     bool frames = false;  // also PSO frames/s
-    std::vector<double> hyp, fps;
+    std::vector<double> hyp = {}, fps = {};
   };
   std::string why;
   Backend cpu1{try_make(gtrack::make_cpu_renderer, 1, why)}, cpu_all{try_make(gtrack::make_cpu_renderer, all, why)},

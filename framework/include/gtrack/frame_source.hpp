@@ -2,8 +2,9 @@
 //
 // open_frame_source() decides by the string: "camera:N" opens device N, an
 // existing folder is read as its image files sorted by name, a .tif/.tiff
-// file as a stack whose pages are the frames (a single page: one frame),
-// anything else is opened as a video with cv::VideoCapture. Every frame must have the sensor's
+// file as a stack whose pages are the frames (a single page: one frame), a
+// DICOM file (.dcm, .dicom, or "DICM" at byte 128) as its frames, anything
+// else is opened as a video with cv::VideoCapture. Every frame must have the sensor's
 // image size; a mismatch is an InputError naming the file (or frame) and both
 // sizes. Frame indices count every frame of the source, including frames
 // skipped by `every` or outside the range, so results line up with the input.
@@ -17,6 +18,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gtrack/export.hpp"
@@ -82,6 +84,9 @@ class GTRACK_API FrameSource {
   // Frames of the range left out, unread, for a newer one (a followed
   // folder with FollowOptions::newest).
   virtual int skipped() const { return 0; }
+  // The size of a pixel (width, height, mm) when the input says it: a
+  // DICOM file's ultrasound region. None otherwise.
+  virtual std::optional<std::pair<double, double>> pixel_size_mm() const { return std::nullopt; }
   // Significant bits of 16-bit images, 8 to 16 (default 16): a 16-bit image
   // is scaled to 8 bits by 255 / (2^bits - 1), values above 2^bits - 1
   // saturating. The first 16-bit image is warned about when its values use

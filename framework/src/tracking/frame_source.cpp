@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdint>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -22,6 +23,7 @@
 #include <tiffio.h>
 
 #include "captured_stderr.hpp"
+#include "dicom.hpp"
 #include "input_kind.hpp"
 #include "video_backend.hpp"
 #include "gtrack/error.hpp"
@@ -377,13 +379,111 @@ int numbered_next(const fs::path& a, const fs::path& b) {
   return y.numbers[static_cast<size_t>(changed)] == x.numbers[static_cast<size_t>(changed)] + 1 ? 1 : 0;
 }
 
+// Frame `k` of a DICOM file as an image OpenCV can take: 8 bits per sample
+// (16-bit samples scaled by the bits the file says it stores), grey or BGR.
+cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, int k, const std::string& name) {
+  const std::string what = name + " frame " + std::to_string(k);
+  std::vector<unsigned char> bytes;
+  for (const auto& [offset, length] : layout.frame_bytes.at(static_cast<std::size_t>(k))) {
+    const std::size_t at = bytes.size();
+    bytes.resize(at + length);
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(offset));
+    if (!in.read(reinterpret_cast<char*>(bytes.data() + at), static_cast<std::streamsize>(length))) {
+      throw InputError(what + ": its bytes cannot be read (the file changed or was cut short since it was opened)");
+    }
+  }
+  const std::string& pi = layout.photometric;
+  cv::Mat image;
+  if (layout.encapsulated) {
+    detail::CapturedStderr library;
+    try {
+      image = cv::imdecode(bytes, cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
+    } catch (const cv::Exception&) {
+      image.release();
+    }
+    const std::string said = library.take();
+    if (image.empty()) {
+      throw InputError(what + ": cannot decode its " + detail::transfer_syntax_name(layout.transfer_syntax) +
+                       " data" + (said.empty() ? std::string() : " (the decoder said: " + said + ")") +
+                       "; convert the file to native pixels, e.g. gdcmconv --raw in.dcm out.dcm");
+    }
+  } else {
+    if (layout.is_signed && layout.bits_allocated == 16) {
+      throw InputError(name + ": signed 16-bit samples (0028,0103); expected unsigned ones, as B-mode images are");
+    }
+    const int depth = layout.bits_allocated == 16 ? CV_16U : CV_8U;
+    if (layout.samples == 1) {
+      image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data()).clone();
+    } else if (layout.planar == 1) {
+      const std::size_t plane = bytes.size() / 3;
+      std::vector<cv::Mat> planes;
+      for (int c = 0; c < 3; ++c) {
+        planes.emplace_back(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data() + plane * c);
+      }
+      cv::merge(planes, image);
+    } else {
+      image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 3), bytes.data()).clone();
+    }
+    if (layout.samples == 3) {
+      if (pi == "RGB") {
+        cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
+      } else if (pi == "YBR_FULL") {
+        // Y, Cb, Cr; OpenCV's order is Y, Cr, Cb.
+        std::vector<cv::Mat> ycc;
+        cv::split(image, ycc);
+        std::swap(ycc[1], ycc[2]);
+        cv::merge(ycc, image);
+        cv::cvtColor(image, image, cv::COLOR_YCrCb2BGR);
+      } else {
+        throw InputError(name + ": colour pixels in photometric interpretation '" + pi +
+                         "' (0028,0004); expected RGB or YBR_FULL (or a compressed file)");
+      }
+    } else if (!pi.empty() && pi != "MONOCHROME1" && pi != "MONOCHROME2") {
+      throw InputError(name + ": grey pixels in photometric interpretation '" + pi +
+                       "' (0028,0004); expected MONOCHROME1 or MONOCHROME2");
+    }
+  }
+  if (image.depth() == CV_16U) {
+    const int stored = layout.bits_stored > 0 && layout.bits_stored <= 16 ? layout.bits_stored : 16;
+    image.convertTo(image, CV_8U, 255.0 / (std::ldexp(1.0, stored) - 1.0));
+  }
+  // MONOCHROME1: the lowest value is white.
+  if (pi == "MONOCHROME1" && image.channels() == 1) cv::bitwise_not(image, image);
+  return image;
+}
+
+// A folder's image named .dcm or .dicom: a single-frame DICOM file (one
+// file per frame, as some scanners export), decoded as a DICOM file's
+// frames are; what cannot be read is said in `said` and gives no image.
+bool is_dicom_name(const fs::path& p) {
+  const std::string ext = lowercase_extension(p);
+  return ext == ".dcm" || ext == ".dicom";
+}
+cv::Mat read_dicom_image(const fs::path& p, std::string& said) {
+  try {
+    std::ifstream in(p, std::ios::binary);
+    if (!in) throw InputError(p.string() + ": cannot open the file");
+    const detail::DicomLayout layout = detail::read_dicom_layout(in, p.string());
+    if (layout.frames != 1) {
+      throw InputError(p.string() + ": a DICOM file of " + std::to_string(layout.frames) +
+                       " frames in a folder of images; give the file itself as --input");
+    }
+    said.clear();
+    return decode_dicom_frame(layout, in, 0, p.string());
+  } catch (const InputError& e) {
+    said = e.what();
+    return cv::Mat();
+  }
+}
+
 class FolderSource final : public FrameSource {
  public:
   FolderSource(const fs::path& dir, ImageSize expected, FrameRange range, double fps, FollowOptions follow)
       : dir_(dir), expected_(expected), filter_(range), fps_(fps), follow_(follow) {
     scan();
     if (files_.empty() && !following()) {
-      throw InputError(dir.string() + ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm)");
+      throw InputError(dir.string() + ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm, .dcm)");
     }
   }
 
@@ -466,7 +566,8 @@ class FolderSource final : public FrameSource {
   // the last one taken, is not tracked (the frame numbers of what was taken
   // never change) and is warned about.
   void scan() {
-    static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
+    static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif",
+                                                  ".tiff", ".pgm", ".ppm", ".dcm", ".dicom"};
     if (following() && unchanged_since_last_listing()) return;
     std::error_code ec;  // of the listing itself
     std::vector<fs::path> found;
@@ -590,6 +691,7 @@ class FolderSource final : public FrameSource {
   };
   ReadImage read(const fs::path& p) const {
     const auto decode = [&p](std::string& said) {
+      if (is_dicom_name(p)) return read_dicom_image(p, said);
       detail::CapturedStderr library;
       cv::Mat img = cv::imread(p.string(), cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
       said = library.take();
@@ -927,6 +1029,54 @@ class StackSource final : public FrameSource {
   std::string ended_early_;             // the directories end in an error
 };
 
+// A DICOM file: its frames in order (a B-mode cine loop exported by a
+// scanner, or a single image), at the frame rate it gives.
+class DicomSource final : public FrameSource {
+ public:
+  DicomSource(std::string spec, ImageSize expected, FrameRange range, double fallback_fps)
+      : spec_(std::move(spec)), expected_(expected), filter_(range), in_(spec_, std::ios::binary) {
+    if (!in_) throw InputError(spec_ + ": cannot open the file");
+    layout_ = detail::read_dicom_layout(in_, spec_);
+    fps_ = layout_.fps > 0 ? layout_.fps : fallback_fps;
+    index_ = std::max(0, range.first);
+    logger().debug("{}: DICOM, {} frame(s) of {}x{}, {} sample(s) of {} bits, {}, {}, {} frames/s", spec_,
+                   layout_.frames, layout_.columns, layout_.rows, layout_.samples, layout_.bits_allocated,
+                   layout_.photometric, detail::transfer_syntax_name(layout_.transfer_syntax), layout_.fps);
+  }
+
+  std::optional<Frame> next() override {
+    while (index_ < layout_.frames && !filter_.done(index_) && !filter_.wanted(index_)) ++index_;
+    if (index_ >= layout_.frames || filter_.done(index_)) return std::nullopt;
+    Frame f;
+    f.index = index_;
+    f.time_s = fps_ > 0 ? index_ / fps_ : 0.0;
+    f.name = spec_ + " frame " + std::to_string(index_);
+    f.image = to_bgr(decode_dicom_frame(layout_, in_, index_, spec_), f.name);
+    check_size(f.image, expected_, f.name);
+    ++index_;
+    return f;
+  }
+  double fps() const override { return fps_; }
+  int frame_count() const override { return layout_.frames; }
+  std::optional<std::pair<double, double>> pixel_size_mm() const override {
+    if (!(layout_.region_mm_x > 0 && layout_.region_mm_y > 0)) return std::nullopt;
+    return std::make_pair(layout_.region_mm_x, layout_.region_mm_y);
+  }
+  std::string description() const override {
+    return spec_ + " (a DICOM file of " + std::to_string(layout_.frames) + " frame" +
+           (layout_.frames == 1 ? "" : "s") + ", " + detail::transfer_syntax_name(layout_.transfer_syntax) + ")";
+  }
+
+ private:
+  std::string spec_;
+  ImageSize expected_;
+  RangeFilter filter_;
+  std::ifstream in_;
+  detail::DicomLayout layout_;
+  double fps_ = 0;
+  int index_ = 0;
+};
+
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
                                         double fallback_fps, bool seek) {
   std::error_code ec;
@@ -986,7 +1136,7 @@ RecordedFrames::RecordedFrames(std::string spec, ImageSize expected, std::vector
     }
   }
   std::error_code ec;
-  video_ = !fs::is_directory(spec_, ec) && !detail::is_tiff_file(spec_);
+  video_ = !fs::is_directory(spec_, ec) && !detail::is_tiff_file(spec_) && !detail::is_dicom_file(spec_);
 }
 
 void RecordedFrames::reading_again(FrameSource& source) const {
@@ -1136,6 +1286,7 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   std::error_code ec;
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
   if (detail::is_tiff_file(spec)) return std::make_unique<StackSource>(spec, expected, range, fallback_fps);
+  if (detail::is_dicom_file(spec)) return std::make_unique<DicomSource>(spec, expected, range, fallback_fps);
   return open_video(spec, expected, range, fallback_fps, false);  // a missing path: "no such file or folder"
 }
 

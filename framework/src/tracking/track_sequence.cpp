@@ -589,6 +589,21 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                   "stimulus log and the material's response run on {:g} (remove fps to take the video's)",
                   options.input, source->fps(), config.tracker.fps, config.tracker.fps);
   }
+  // A pixel size the input gives (a scanner's DICOM export) that is not the
+  // sensor's: positions would be scaled wrong.
+  if (const auto pixel = source->pixel_size_mm(); pixel && setup.sensor->mm_per_pixel() > 0) {
+    const double said = setup.sensor->mm_per_pixel();
+    const auto off = [said](double v) { return std::abs(v / said - 1) > 0.02; };
+    if (off(pixel->first) || off(pixel->second)) {
+      logger().warn("{}: its pixels are {:.4g} x {:.4g} mm (width x height, as the file says), the sensor's {:.4g} "
+                    "mm: positions and the gripper's size in the image are taken at the sensor's; set [sensor] "
+                    "to the file's (an ultrasound_slice: mm_per_pixel)",
+                    options.input, pixel->first, pixel->second, said);
+    } else {
+      logger().debug("{}: its pixels are {:.4g} x {:.4g} mm, as the sensor's", options.input, pixel->first,
+                     pixel->second);
+    }
+  }
   // The readings are checked before a frame is tracked, each by an instance
   // of the stimulus plugin of its own: the configured default, and each log
   // row as it is read, at its frame's time, so that one the plugin refuses

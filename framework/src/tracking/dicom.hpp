@@ -1,0 +1,48 @@
+// A DICOM file's image layout: what its frames are and where their bytes
+// lie, read without decoding them (and without a DICOM library: OpenCV's
+// reads single frames only). A B-mode cine loop exported by a scanner is
+// one multi-frame file: native pixels (8 or 16 bits, grey or colour), or
+// each frame compressed as JPEG or JPEG 2000 (decoded by OpenCV).
+#pragma once
+
+#include <cstdint>
+#include <istream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace gtrack::detail {
+
+struct DicomLayout {
+  int rows = 0, columns = 0;
+  int samples = 1;         // per pixel: 1 (grey) or 3 (colour)
+  int bits_allocated = 8;  // 8 or 16
+  int bits_stored = 0;     // 0: as allocated
+  bool is_signed = false;
+  int planar = 0;  // 3 samples: 0 = interleaved, 1 = one plane after the other
+  int frames = 1;
+  std::string photometric;      // MONOCHROME2, RGB, YBR_FULL_422, ...
+  std::string transfer_syntax;  // its UID
+  bool encapsulated = false;    // compressed: each frame's fragments are a JPEG or JPEG 2000 stream
+  double fps = 0;               // from the frame time or the cine rate; 0 when the file gives none
+  // The first ultrasound region's pixel size (0018,6011: PhysicalDeltaX and
+  // Y in cm), in mm; 0 when the file gives none.
+  double region_mm_x = 0, region_mm_y = 0;
+  // Each frame's bytes: (offset in the file, length) spans, one for native
+  // pixels, one or more fragments when encapsulated.
+  std::vector<std::vector<std::pair<std::uint64_t, std::uint64_t>>> frame_bytes;
+};
+
+// Reads the layout from the file's start (with its 128-byte preamble and
+// "DICM", or a bare dataset in implicit VR). InputError naming `name`, the
+// byte offset and what was expected, for anything it cannot take.
+DicomLayout read_dicom_layout(std::istream& in, const std::string& name);
+
+// A regular file named .dcm or .dicom (any case), or with "DICM" at byte
+// 128, as scanners export without an extension.
+bool is_dicom_file(const std::string& spec);
+
+// The transfer syntax by name, for messages ("JPEG baseline (1.2.840...)").
+std::string transfer_syntax_name(const std::string& uid);
+
+}  // namespace gtrack::detail

@@ -1,0 +1,32 @@
+// Fuzz target: a DICOM file's layout, read by `gtrack track --input
+// file.dcm` (and for each .dcm image of a folder).
+//
+// A layout that reads has an image size, 1 or 3 samples, at least one
+// frame, and every frame's bytes inside the file. Only gtrack::Error
+// (InputError) may come out of read_dicom_layout().
+#include <cstddef>
+#include <cstdint>
+#include <sstream>
+#include <string>
+
+#include "gtrack/error.hpp"
+#include "tracking/dicom.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
+  gtrack::detail::DicomLayout layout;
+  try {
+    layout = gtrack::detail::read_dicom_layout(in, "fuzz.dcm");
+  } catch (const gtrack::Error&) {
+    return 0;
+  }
+  if (layout.rows <= 0 || layout.columns <= 0 || (layout.samples != 1 && layout.samples != 3)) __builtin_trap();
+  if (layout.frames < 1 || layout.frame_bytes.size() != static_cast<std::size_t>(layout.frames)) __builtin_trap();
+  for (const auto& spans : layout.frame_bytes) {
+    if (spans.empty()) __builtin_trap();
+    for (const auto& [offset, length] : spans) {
+      if (offset > size || length > size - offset) __builtin_trap();
+    }
+  }
+  return 0;
+}

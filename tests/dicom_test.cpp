@@ -1,0 +1,324 @@
+// DICOM input: a scanner's multi-frame file (native, JPEG or JPEG 2000
+// frames) read frame by frame, its frame rate taken, and what it cannot
+// take refused in a line; a B-mode cine loop tracked as its frames are.
+#include <gtest/gtest.h>
+#include <gtrack/frame_source.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "gtrack/error.hpp"
+#include "support/dicom_writer.hpp"
+
+namespace fs = std::filesystem;
+using gtrack::testing::DicomWriteOptions;
+using gtrack::testing::write_dicom;
+
+namespace {
+
+fs::path dir_for(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_dicom_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Frames unlike each other and unlike their mirror: a gradient, a
+// square that moves, noise.
+std::vector<cv::Mat> frames(int n, int type = CV_8UC1, int w = 40, int h = 30) {
+  std::vector<cv::Mat> out;
+  cv::RNG rng(7);
+  for (int i = 0; i < n; ++i) {
+    cv::Mat m(h, w, type);
+    rng.fill(m, cv::RNG::UNIFORM, 0, type == CV_16UC1 ? 4096 : 256);
+    cv::rectangle(m, cv::Rect(2 + 5 * i, 3, 8, 6), cv::Scalar::all(type == CV_16UC1 ? 4095 : 255), cv::FILLED);
+    out.push_back(m);
+  }
+  return out;
+}
+
+std::vector<cv::Mat> read_all(const fs::path& file, cv::Size size, double* fps = nullptr, std::string* what = nullptr) {
+  auto src = gtrack::open_frame_source(file.string(), {size.width, size.height}, {}, 30);
+  if (fps) *fps = src->fps();
+  if (what) *what = src->description();
+  std::vector<cv::Mat> out;
+  while (auto f = src->next()) out.push_back(f->image);
+  return out;
+}
+
+cv::Mat bgr(const cv::Mat& m) {
+  cv::Mat out;
+  if (m.channels() == 1) {
+    cv::cvtColor(m, out, cv::COLOR_GRAY2BGR);
+  } else {
+    out = m;
+  }
+  return out;
+}
+
+bool same(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
+}
+
+std::string input_error(const fs::path& file, cv::Size size = {40, 30}) {
+  try {
+    read_all(file, size);
+  } catch (const gtrack::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// Native grey frames, in explicit VR with the file meta group and in a
+// bare implicit-VR dataset (with a sequence of undefined length before the
+// image): the frames written, at the rate of the file's frame time.
+TEST(Dicom, NativeFramesAreTheImagesWrittenAtTheFilesRate) {
+  const fs::path dir = dir_for("native");
+  const auto written = frames(3);
+  DicomWriteOptions o;
+  o.frame_time_ms = 40;
+  write_dicom(dir / "cine.dcm", written, o);
+  double fps = 0;
+  std::string what;
+  auto got = read_all(dir / "cine.dcm", {40, 30}, &fps, &what);
+  ASSERT_EQ(got.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], bgr(written[i]))) << "frame " << i;
+  EXPECT_DOUBLE_EQ(fps, 25);
+  EXPECT_NE(what.find("a DICOM file of 3 frames, explicit VR little endian"), std::string::npos) << what;
+
+  DicomWriteOptions bare;
+  bare.transfer_syntax = "1.2.840.10008.1.2";
+  bare.preamble = false;
+  bare.sequence_before = true;
+  write_dicom(dir / "bare.dcm", written, bare);
+  got = read_all(dir / "bare.dcm", {40, 30}, &fps);
+  ASSERT_EQ(got.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], bgr(written[i]))) << "frame " << i;
+  EXPECT_DOUBLE_EQ(fps, 30) << "no frame time: the fallback rate";
+  EXPECT_FALSE(gtrack::open_frame_source((dir / "bare.dcm").string(), {40, 30}, {}, 30)->pixel_size_mm())
+      << "a region with no pixel size gives none";
+  DicomWriteOptions region;
+  region.region_cm_x = 0.009;
+  region.region_cm_y = 0.0095;
+  for (const char* syntax : {"1.2.840.10008.1.2.1", "1.2.840.10008.1.2"}) {
+    region.transfer_syntax = syntax;
+    write_dicom(dir / "region.dcm", written, region);
+    const auto pixel = gtrack::open_frame_source((dir / "region.dcm").string(), {40, 30}, {}, 30)->pixel_size_mm();
+    ASSERT_TRUE(pixel) << syntax;
+    EXPECT_NEAR(pixel->first, 0.09, 1e-12) << syntax;
+    EXPECT_NEAR(pixel->second, 0.095, 1e-12) << syntax;
+  }
+
+  // Scanners export without an extension: "DICM" at byte 128 says what it is.
+  fs::copy_file(dir / "cine.dcm", dir / "IM_0001");
+  EXPECT_EQ(read_all(dir / "IM_0001", {40, 30}).size(), 3u);
+  // A range and a stride count from the file's first frame.
+  auto src = gtrack::open_frame_source((dir / "cine.dcm").string(), {40, 30}, {1, -1, 1}, 30);
+  std::vector<int> indices;
+  while (auto f = src->next()) indices.push_back(f->index);
+  EXPECT_EQ(indices, (std::vector<int>{1, 2}));
+  // Read again in blocks, as --two-pass does.
+  gtrack::RecordedFrames recording((dir / "cine.dcm").string(), {40, 30}, {0, 1, 2}, 1, 30);
+  EXPECT_TRUE(same(recording.read(2, 3).at(2), bgr(written[2])));
+}
+
+// A folder of single-frame DICOM files (one file per frame) is read as a
+// folder of images; a multi-frame file in it is refused, pointing to it.
+TEST(Dicom, AFolderOfSingleFrameFilesIsAFolderOfImages) {
+  const fs::path dir = dir_for("folder");
+  const auto written = frames(3);
+  for (int i = 0; i < 3; ++i) write_dicom(dir / ("IM" + std::to_string(i) + ".dcm"), {written[static_cast<std::size_t>(i)]});
+  const auto got = read_all(dir, {40, 30});
+  ASSERT_EQ(got.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], bgr(written[i]))) << "frame " << i;
+  write_dicom(dir / "IM3.dcm", written);
+  const std::string e = input_error(dir);
+  EXPECT_NE(e.find("IM3.dcm: a DICOM file of 3 frames in a folder of images; give the file itself as --input"),
+            std::string::npos)
+      << e;
+}
+
+// Colour (interleaved and planar), 16-bit samples of 12 stored bits, and
+// MONOCHROME1's inverted grey.
+TEST(Dicom, ColourSixteenBitAndInvertedGreyFramesAreTakenAsTheFileSays) {
+  const fs::path dir = dir_for("kinds");
+  const auto colour = frames(2, CV_8UC3);
+  for (int planar : {0, 1}) {
+    DicomWriteOptions o;
+    o.planar = planar;
+    write_dicom(dir / "colour.dcm", colour, o);
+    const auto got = read_all(dir / "colour.dcm", {40, 30});
+    ASSERT_EQ(got.size(), 2u);
+    EXPECT_TRUE(same(got[1], colour[1])) << "planar " << planar;
+  }
+  std::vector<cv::Mat> twelve = {cv::Mat(30, 40, CV_16UC1, cv::Scalar(4095)), cv::Mat(30, 40, CV_16UC1, cv::Scalar(2048))};
+  DicomWriteOptions o12;
+  o12.bits_stored = 12;
+  write_dicom(dir / "twelve.dcm", twelve, o12);
+  auto got = read_all(dir / "twelve.dcm", {40, 30});
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].at<cv::Vec3b>(5, 5), cv::Vec3b::all(255));
+  EXPECT_EQ(got[1].at<cv::Vec3b>(5, 5), cv::Vec3b::all(128));
+  DicomWriteOptions inverted;
+  inverted.photometric = "MONOCHROME1";
+  write_dicom(dir / "inverted.dcm", {cv::Mat(30, 40, CV_8UC1, cv::Scalar(10))}, inverted);
+  got = read_all(dir / "inverted.dcm", {40, 30});
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].at<cv::Vec3b>(5, 5), cv::Vec3b::all(245));
+}
+
+// Compressed frames: JPEG with a fragment per frame, JPEG split in
+// fragments found by the offset table, and JPEG 2000.
+TEST(Dicom, CompressedFramesAreDecodedFrameByFrame) {
+  const fs::path dir = dir_for("compressed");
+  const auto written = frames(3, CV_8UC3, 64, 48);
+  std::vector<cv::Mat> jpeg;
+  for (const cv::Mat& f : written) {
+    std::vector<unsigned char> bytes;
+    cv::imencode(".jpg", f, bytes);
+    jpeg.push_back(cv::imdecode(bytes, cv::IMREAD_COLOR));
+  }
+  DicomWriteOptions o;
+  o.transfer_syntax = "1.2.840.10008.1.2.4.50";
+  o.compress_as = ".jpg";
+  o.photometric = "YBR_FULL_422";
+  write_dicom(dir / "jpeg.dcm", written, o);
+  auto got = read_all(dir / "jpeg.dcm", {64, 48});
+  ASSERT_EQ(got.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], jpeg[i])) << "frame " << i;
+  o.fragments_per_frame = 2;
+  o.offset_table = true;
+  write_dicom(dir / "fragments.dcm", written, o);
+  got = read_all(dir / "fragments.dcm", {64, 48});
+  ASSERT_EQ(got.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], jpeg[i])) << "frame " << i;
+  // Fragments that neither the count nor an offset table assign to frames.
+  o.offset_table = false;
+  write_dicom(dir / "unassigned.dcm", written, o);
+  const std::string e = input_error(dir / "unassigned.dcm", {64, 48});
+  EXPECT_NE(e.find("expected one fragment per frame or an offset per frame"), std::string::npos) << e;
+
+  std::vector<unsigned char> probe;
+  bool j2k = false;
+  try {
+    j2k = cv::imencode(".jp2", written[0], probe);
+  } catch (const cv::Exception&) {
+    j2k = false;
+  }
+  if (j2k) {
+    DicomWriteOptions o2;
+    o2.transfer_syntax = "1.2.840.10008.1.2.4.90";
+    o2.compress_as = ".jp2";
+    write_dicom(dir / "j2k.dcm", written, o2);
+    got = read_all(dir / "j2k.dcm", {64, 48});
+    ASSERT_EQ(got.size(), 3u);
+    for (int i = 0; i < 3; ++i) {
+      std::vector<unsigned char> bytes;
+      cv::imencode(".jp2", written[static_cast<std::size_t>(i)], bytes);
+      EXPECT_TRUE(same(got[i], cv::imdecode(bytes, cv::IMREAD_COLOR))) << "frame " << i;
+    }
+  }
+}
+
+// What it cannot take is one line naming the file and what was expected.
+TEST(Dicom, AFileItCannotTakeIsRefusedInALine) {
+  const fs::path dir = dir_for("refused");
+  const auto written = frames(2);
+  write_dicom(dir / "whole.dcm", written);
+  std::string bytes;
+  {
+    std::ifstream in(dir / "whole.dcm", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // Cut short in the pixel data, and in the header.
+  std::ofstream(dir / "short.dcm", std::ios::binary) << bytes.substr(0, bytes.size() - 100);
+  std::string e = input_error(dir / "short.dcm");
+  EXPECT_NE(e.find("short.dcm: byte "), std::string::npos) << e;
+  EXPECT_NE(e.find("bytes; the file has"), std::string::npos) << e;
+  std::ofstream(dir / "header.dcm", std::ios::binary) << bytes.substr(0, 200);
+  e = input_error(dir / "header.dcm");
+  EXPECT_NE(e.find("header.dcm: "), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  // Not DICOM at all, named so.
+  std::ofstream(dir / "text.dcm") << std::string(300, 'x');
+  e = input_error(dir / "text.dcm");
+  EXPECT_NE(e.find("text.dcm: "), std::string::npos) << e;
+  // A transfer syntax it does not decode.
+  DicomWriteOptions rle;
+  rle.transfer_syntax = "1.2.840.10008.1.2.5";
+  write_dicom(dir / "rle.dcm", written, rle);
+  e = input_error(dir / "rle.dcm");
+  EXPECT_NE(e.find("rle.dcm: its pixels are stored as RLE lossless (1.2.840.10008.1.2.5); expected native pixels"),
+            std::string::npos)
+      << e;
+  // Another size than the sensor's, naming the frame.
+  e = input_error(dir / "whole.dcm", {64, 48});
+  EXPECT_NE(e.find("whole.dcm frame 0: image is 40x30 but the sensor expects 64x48"), std::string::npos) << e;
+  // Every prefix of a good file is refused in a line or read, never more.
+  for (std::size_t n = 0; n < bytes.size(); n += 37) {
+    try {
+      std::ofstream(dir / "prefix.dcm", std::ios::binary) << bytes.substr(0, n);
+      read_all(dir / "prefix.dcm", {40, 30});
+    } catch (const gtrack::InputError& error) {
+      EXPECT_EQ(std::string(error.what()).find('\n'), std::string::npos) << n;
+    }
+  }
+}
+
+// A B-mode cine loop as one DICOM file is tracked as its frames are when
+// they are images in a folder.
+TEST(Dicom, AnUltrasoundCineLoopIsTrackedAsItsFramesAre) {
+  const fs::path dir = dir_for("cine");
+  const std::string gtrack = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack ";
+  const auto run = [&](const std::string& args) {
+    return std::system((gtrack + args + " > " + (dir / "log.txt").string() + " 2>&1").c_str());
+  };
+  ASSERT_EQ(run("synth --preset ultrasound --frames 4 --seed 3 --out " + dir.string()), 0);
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < 4; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    images.push_back(cv::imread((dir / "frames" / name).string(), cv::IMREAD_COLOR));
+    ASSERT_FALSE(images.back().empty()) << name;
+  }
+  DicomWriteOptions o;
+  o.frame_time_ms = 1000.0 / 30;
+  o.region_cm_x = o.region_cm_y = 0.009;  // the sensor's 0.09 mm
+  write_dicom(dir / "cine.dcm", images, o);
+  const std::string common = "track -c " + (dir / "sequence.toml").string() + " --stimulus " +
+                             (dir / "stimulus.csv").string() + " --no-overlay";
+  ASSERT_EQ(run(common + " -i " + (dir / "frames").string() + " -o " + (dir / "from_folder").string()), 0);
+  ASSERT_EQ(run(common + " -i " + (dir / "cine.dcm").string() + " -o " + (dir / "from_dicom").string()), 0);
+  const auto poses = [](const fs::path& csv) {
+    std::ifstream in(csv);
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);) rows.push_back(line.substr(0, line.rfind(',')));  // less ms
+    return rows;
+  };
+  const auto folder = poses(dir / "from_folder" / "estimates.csv");
+  EXPECT_EQ(folder.size(), 5u);
+  EXPECT_EQ(poses(dir / "from_dicom" / "estimates.csv"), folder);
+  const auto log = [&] {
+    std::ifstream in(dir / "log.txt");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(log().find("its pixels are"), std::string::npos) << "the sensor's size: " << log();
+  // A file whose pixels are not the sensor's size is warned about.
+  o.region_cm_x = o.region_cm_y = 0.012;
+  write_dicom(dir / "wide.dcm", images, o);
+  ASSERT_EQ(run(common + " --frames 0:1 -i " + (dir / "wide.dcm").string() + " -o " + (dir / "wide").string()), 0);
+  EXPECT_NE(log().find("wide.dcm: its pixels are 0.12 x 0.12 mm (width x height, as the file says), the sensor's "
+                       "0.09 mm"),
+            std::string::npos)
+      << log();
+}
