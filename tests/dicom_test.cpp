@@ -148,8 +148,8 @@ TEST(Dicom, AFolderOfSingleFrameFilesIsAFolderOfImages) {
       << e;
 }
 
-// Colour (interleaved and planar), 16-bit samples of 12 stored bits, and
-// MONOCHROME1's inverted grey.
+// Colour (RGB interleaved and planar, YBR_FULL_422), 16-bit samples of 12
+// stored bits, and MONOCHROME1's inverted grey.
 TEST(Dicom, ColourSixteenBitAndInvertedGreyFramesAreTakenAsTheFileSays) {
   const fs::path dir = dir_for("kinds");
   const auto colour = frames(2, CV_8UC3);
@@ -161,6 +161,17 @@ TEST(Dicom, ColourSixteenBitAndInvertedGreyFramesAreTakenAsTheFileSays) {
     ASSERT_EQ(got.size(), 2u);
     EXPECT_TRUE(same(got[1], colour[1])) << "planar " << planar;
   }
+  // YBR_FULL_422: each two pixels share their colour (blocks of even width here).
+  cv::Mat blocks(30, 40, CV_8UC3);
+  for (int x = 0; x < 40; x += 2) {
+    blocks.colRange(x, x + 2).setTo(cv::Scalar(6 * x, 255 - 6 * x, 3 * x + 40));
+  }
+  DicomWriteOptions ybr;
+  ybr.photometric = "YBR_FULL_422";
+  write_dicom(dir / "ybr422.dcm", {blocks}, ybr);
+  const auto got422 = read_all(dir / "ybr422.dcm", {40, 30});
+  ASSERT_EQ(got422.size(), 1u);
+  EXPECT_LE(cv::norm(got422[0], blocks, cv::NORM_INF), 3) << "within the colour conversion's rounding";
   std::vector<cv::Mat> twelve = {cv::Mat(30, 40, CV_16UC1, cv::Scalar(4095)), cv::Mat(30, 40, CV_16UC1, cv::Scalar(2048))};
   DicomWriteOptions o12;
   o12.bits_stored = 12;

@@ -131,6 +131,18 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
   if (o.compress_as.empty()) {
     std::string pixels;
     for (const cv::Mat& f : frames) {
+      if (colour && o.photometric == "YBR_FULL_422") {
+        // Two pixels in four bytes: Y0, Y1, and the pair's first Cb and Cr.
+        cv::Mat ycc;
+        cv::cvtColor(f, ycc, cv::COLOR_BGR2YCrCb);
+        for (int y = 0; y < ycc.rows; ++y) {
+          for (int x = 0; x + 1 < ycc.cols; x += 2) {
+            const cv::Vec3b a = ycc.at<cv::Vec3b>(y, x), b = ycc.at<cv::Vec3b>(y, x + 1);
+            pixels += {char(a[0]), char(b[0]), char(a[2]), char(a[1])};
+          }
+        }
+        continue;
+      }
       cv::Mat m;  // a new buffer: the caller's frame stays as it was
       if (colour) {
         cv::cvtColor(f, m, cv::COLOR_BGR2RGB);

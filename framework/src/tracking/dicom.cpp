@@ -381,8 +381,14 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
                        " bits allocated per sample (0028,0100); expected 8 or 16");
     }
     if (pixels->length == kUndefined) r.fail(pixels->value_at, "native pixel data of a defined length");
-    const std::uint64_t frame = std::uint64_t(out.rows) * std::uint64_t(out.columns) * std::uint64_t(out.samples) *
-                                std::uint64_t(out.bits_allocated / 8);
+    // YBR_FULL_422: two pixels in four bytes (Y, Y, Cb, Cr).
+    const bool ybr_422 = out.photometric == "YBR_FULL_422" && out.samples == 3;
+    if (ybr_422 && (out.bits_allocated != 8 || out.columns % 2 != 0)) {
+      throw InputError(name + ": YBR_FULL_422 pixels of " + std::to_string(out.bits_allocated) + " bits in rows of " +
+                       std::to_string(out.columns) + "; expected 8 bits and an even number of columns");
+    }
+    const std::uint64_t frame = std::uint64_t(out.rows) * std::uint64_t(out.columns) *
+                                std::uint64_t(ybr_422 ? 2 : out.samples) * std::uint64_t(out.bits_allocated / 8);
     const std::uint64_t needed = frame * std::uint64_t(out.frames);
     if (pixels->length < needed) {
       throw InputError(fmt::format("{}: its pixel data holds {} bytes; {} frame(s) of {}x{}, {} sample(s) of {} bits "

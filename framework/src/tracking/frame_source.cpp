@@ -413,7 +413,19 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
       throw InputError(name + ": signed 16-bit samples (0028,0103); expected unsigned ones, as B-mode images are");
     }
     const int depth = layout.bits_allocated == 16 ? CV_16U : CV_8U;
-    if (layout.samples == 1) {
+    if (layout.samples == 3 && pi == "YBR_FULL_422") {
+      // Each two pixels: Y0, Y1, Cb, Cr (8 bits, checked with the layout).
+      image.create(layout.rows, layout.columns, CV_8UC3);  // Y, Cr, Cb, OpenCV's order
+      const unsigned char* in_px = bytes.data();
+      for (int y = 0; y < layout.rows; ++y) {
+        auto* row = image.ptr<cv::Vec3b>(y);
+        for (int x = 0; x < layout.columns; x += 2, in_px += 4) {
+          row[x] = cv::Vec3b(in_px[0], in_px[3], in_px[2]);
+          row[x + 1] = cv::Vec3b(in_px[1], in_px[3], in_px[2]);
+        }
+      }
+      cv::cvtColor(image, image, cv::COLOR_YCrCb2BGR);
+    } else if (layout.samples == 1) {
       image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data()).clone();
     } else if (layout.planar == 1) {
       const std::size_t plane = bytes.size() / 3;
@@ -428,6 +440,8 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
     if (layout.samples == 3) {
       if (pi == "RGB") {
         cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
+      } else if (pi == "YBR_FULL_422") {
+        // Converted above.
       } else if (pi == "YBR_FULL") {
         // Y, Cb, Cr; OpenCV's order is Y, Cr, Cb.
         std::vector<cv::Mat> ycc;
@@ -437,7 +451,7 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
         cv::cvtColor(image, image, cv::COLOR_YCrCb2BGR);
       } else {
         throw InputError(name + ": colour pixels in photometric interpretation '" + pi +
-                         "' (0028,0004); expected RGB or YBR_FULL (or a compressed file)");
+                         "' (0028,0004); expected RGB, YBR_FULL or YBR_FULL_422 (or a compressed file)");
       }
     } else if (!pi.empty() && pi != "MONOCHROME1" && pi != "MONOCHROME2") {
       throw InputError(name + ": grey pixels in photometric interpretation '" + pi +

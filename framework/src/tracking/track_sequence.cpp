@@ -24,6 +24,7 @@
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/tracker.hpp"
 #include "captured_stderr.hpp"
+#include "dicom.hpp"
 #include "input_kind.hpp"
 #include "console.hpp"
 #include "nearest_equivalent.hpp"
@@ -585,9 +586,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   if (config.tracker.fps > 0 && source->fps() > 0 && std::abs(source->fps() / config.tracker.fps - 1) > 0.01) {
     // A video's own rate set aside: its frame times, a time_s log and the
     // stimulus's response run on the config's.
-    logger().warn("{}: the video says {:g} frames/s, [tracker] fps = {:g} is taken; its frame times, a time_s "
-                  "stimulus log and the material's response run on {:g} (remove fps to take the video's)",
-                  options.input, source->fps(), config.tracker.fps, config.tracker.fps);
+    logger().warn("{}: the {} says {:g} frames/s, [tracker] fps = {:g} is taken; its frame times, a time_s "
+                  "stimulus log and the material's response run on {:g} (remove fps to take the file's)",
+                  options.input, detail::is_dicom_file(options.input) ? "DICOM file" : "video", source->fps(),
+                  config.tracker.fps, config.tracker.fps);
   }
   // A pixel size the input gives (a scanner's DICOM export) that is not the
   // sensor's: positions would be scaled wrong.
