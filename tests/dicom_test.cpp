@@ -329,7 +329,8 @@ TEST(Dicom, AnUltrasoundCineLoopIsTrackedAsItsFramesAre) {
   write_dicom(dir / "wide.dcm", images, o);
   ASSERT_EQ(run(common + " --frames 0:1 -i " + (dir / "wide.dcm").string() + " -o " + (dir / "wide").string()), 0);
   EXPECT_NE(log().find("wide.dcm: its pixels are 0.12 x 0.12 mm (width x height, as the file says), the sensor's "
-                       "0.09 mm"),
+                       "0.09 x 0.09 mm"),
             std::string::npos)
       << log();
+  EXPECT_NE(log().find("mm_per_pixel = 0.12, mm_per_pixel_depth = 0.12"), std::string::npos) << log();
 }

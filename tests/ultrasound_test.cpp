@@ -100,4 +100,21 @@ TEST(UltrasoundSlice, ProjectAgreesWithTheProjectionAndTheSlab) {
   EXPECT_EQ(sensor->segmentation_defaults().color_space, "luminance");
 }
 
+// Pixels that are not square: the depth's spacing scales the rows, the
+// lateral one the columns, in the projection and in project() alike.
+TEST(UltrasoundSlice, ADepthSpacingOfItsOwnScalesTheRows) {
+  auto sensor = make_sensor("plugin = \"ultrasound_slice\"\nmm_per_pixel = 0.1\nmm_per_pixel_depth = 0.12");
+  const Eigen::Vector3d x(2.0, 24.0, 0.0);
+  const auto q = sensor->project(x);
+  ASSERT_TRUE(q);
+  EXPECT_NEAR(q->x(), 2.0 / 0.1 + 512, 1e-9);
+  EXPECT_NEAR(q->y(), 24.0 / 0.12, 1e-9);
+  const Eigen::Vector3d hq = sensor->projection().world_to_image * x.homogeneous();
+  EXPECT_NEAR(hq.x() / hq.z(), q->x(), 1e-9);
+  EXPECT_NEAR(hq.y() / hq.z(), q->y(), 1e-9);
+  EXPECT_DOUBLE_EQ(sensor->mm_per_pixel(), 0.1);
+  // The nominal position is at the image's middle row.
+  EXPECT_NEAR(sensor->project(sensor->nominal_position_mm())->y(), 331, 1e-9);
+}
+
 }  // namespace

@@ -592,15 +592,22 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                   config.tracker.fps, config.tracker.fps);
   }
   // A pixel size the input gives (a scanner's DICOM export) that is not the
-  // sensor's: positions would be scaled wrong.
+  // sensor's: positions would be scaled wrong. An affine projection (a
+  // slice) gives the sensor's width and height of a pixel; a camera's,
+  // mm_per_pixel for both.
   if (const auto pixel = source->pixel_size_mm(); pixel && setup.sensor->mm_per_pixel() > 0) {
-    const double said = setup.sensor->mm_per_pixel();
-    const auto off = [said](double v) { return std::abs(v / said - 1) > 0.02; };
-    if (off(pixel->first) || off(pixel->second)) {
-      logger().warn("{}: its pixels are {:.4g} x {:.4g} mm (width x height, as the file says), the sensor's {:.4g} "
-                    "mm: positions and the gripper's size in the image are taken at the sensor's; set [sensor] "
-                    "to the file's (an ultrasound_slice: mm_per_pixel)",
-                    options.input, pixel->first, pixel->second, said);
+    const Projection p = setup.sensor->projection();
+    const bool affine = p.world_to_image.row(2).head<3>().isZero() && p.world_to_image(2, 3) != 0;
+    const double w = affine ? std::abs(p.world_to_image(2, 3)) / p.world_to_image.row(0).head<3>().norm()
+                            : setup.sensor->mm_per_pixel();
+    const double h = affine ? std::abs(p.world_to_image(2, 3)) / p.world_to_image.row(1).head<3>().norm()
+                            : setup.sensor->mm_per_pixel();
+    const auto off = [](double file, double sensor) { return !(std::abs(file / sensor - 1) <= 0.02); };
+    if (off(pixel->first, w) || off(pixel->second, h)) {
+      logger().warn("{}: its pixels are {:.4g} x {:.4g} mm (width x height, as the file says), the sensor's {:.4g} x "
+                    "{:.4g} mm: positions and the gripper's size in the image are taken at the sensor's; set [sensor] "
+                    "to the file's (an ultrasound_slice: mm_per_pixel = {:.4g}, mm_per_pixel_depth = {:.4g})",
+                    options.input, pixel->first, pixel->second, w, h, pixel->first, pixel->second);
     } else {
       logger().debug("{}: its pixels are {:.4g} x {:.4g} mm, as the sensor's", options.input, pixel->first,
                      pixel->second);
