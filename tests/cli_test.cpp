@@ -673,6 +673,38 @@ std::string truth_as_estimates(const fs::path& truth, int every = 1) {
 // A run with --frames and --every has no row for the frames it skipped:
 // eval counts them as lost and says which options judge only the others;
 // with them, only those frames are judged.
+// --off-track-in-plane leaves depth out of the off-track judgement: an
+// estimate 300 um deeper than the truth is off track at 200 um in 3D and
+// on track across the viewing axis.
+TEST(Cli, EvalJudgesOffTrackAcrossTheViewingAxisWhenAsked) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "off_track_in_plane";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 2 --seed 4 --out " + dir.string()).code, 0);
+  std::string rows_text;
+  {
+    std::stringstream in(read_file(dir / "ground_truth.csv"));
+    bool header = true;
+    for (std::string l; std::getline(in, l); header = false) {
+      for (int k = 0; k < 3; ++k) l.erase(l.rfind(','));  // the truth's share columns
+      if (!header) {
+        // frame,x,y,z,...: z 0.3 mm further.
+        const std::size_t a = l.find(',', l.find(',', l.find(',') + 1) + 1) + 1, b = l.find(',', a);
+        l.replace(a, b - a, std::to_string(std::stod(l.substr(a, b - a)) + 0.3));
+      }
+      rows_text += l + "\n";
+    }
+  }
+  std::ofstream(dir / "deeper.csv") << rows_text;
+  const std::string eval = "eval -t " + (dir / "ground_truth.csv").string() + " -e " + (dir / "deeper.csv").string();
+  CliRun r = gtrack(eval + " --off-track-um 200");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 off track: endpoints > 200 um in 3D"), std::string::npos) << r.output;
+  r = gtrack(eval + " --off-track-um 200 --off-track-in-plane --json " + (dir / "e.json").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("0 off track: endpoints > 200 um across the viewing axis"), std::string::npos) << r.output;
+  EXPECT_NE(read_file(dir / "e.json").find("\"off_track_in_plane\": true"), std::string::npos);
+}
+
 TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_every";
   fs::remove_all(dir);
