@@ -22,6 +22,14 @@ namespace fs = std::filesystem;
 namespace dll = boost::dll;
 
 namespace {
+
+// A plugin name is part of a file name, libgtrack_<name>.so: letters,
+// digits, '_' and '-', 1 to 64 of them.
+bool is_plugin_name(const std::string& name) {
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+           return std::isalnum(c) || c == '_' || c == '-';
+         });
+}
 // Guards every loader's list of the plugins it made.
 std::mutex& loaded_mutex() {
   static std::mutex mutex;
@@ -233,13 +241,10 @@ std::vector<fs::path> PluginLoader::set_aside_by(const fs::path& taken) const {
 }
 
 fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
-  // A name is a file name part, never a path.
-  const bool word = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
-    return std::isalnum(c) || c == '_' || c == '-' || c == '.';
-  }) && name.find("..") == std::string::npos;
-  if (!word) {
+  // A name is a file name part, never a path: the rule of make()'s check.
+  if (!is_plugin_name(name)) {
     throw PluginError(std::string(to_string(kind)) + " plugin name '" + name +
-                      "': expected letters, digits, '_', '-' or '.' (a name, not a path; use plugin_path for folders)");
+                      "': expected letters, digits, '_' and '-' (a name, not a path; use plugin_path for folders)");
   }
   for (const auto& dir : paths_) {
     fs::path f = dir / library_file_name(name);
@@ -332,12 +337,7 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
                              table.misspelling_hint("plugin"));
   }
   const std::string name = table.string("plugin");
-  // A plugin name is part of a file name: libgtrack_<name>.so.
-  const bool valid = !name.empty() && name.size() <= 64 &&
-                     std::all_of(name.begin(), name.end(), [](char c) {
-                       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
-                     });
-  if (!valid) {
+  if (!is_plugin_name(name)) {
     table.fail("plugin", "expected a plugin name (letters, digits, '_' and '-', 1 to 64 characters), got a string of " +
                              std::to_string(name.size()) + " characters");
   }
