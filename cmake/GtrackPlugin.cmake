@@ -5,7 +5,7 @@
 # Used for the built-in plugins and, through find_package(gtrack), by plugin
 # authors out of tree.
 function(gtrack_add_plugin name)
-  cmake_parse_arguments(ARG "" "KIND;OUTPUT_DIRECTORY" "SOURCES" ${ARGN})
+  cmake_parse_arguments(ARG "NO_EXPORT_CHECK" "KIND;OUTPUT_DIRECTORY" "SOURCES" ${ARGN})
   if(NOT ARG_KIND MATCHES "^(sensor|gripper|stimulus)$")
     message(FATAL_ERROR "gtrack_add_plugin(${name}): KIND must be sensor, gripper or stimulus, got '${ARG_KIND}'")
   endif()
@@ -31,9 +31,15 @@ function(gtrack_add_plugin name)
   if(NOT CMAKE_BUILD_TYPE AND NOT CMAKE_CONFIGURATION_TYPES)
     target_compile_options(${name} PRIVATE -O2)
   endif()
-  # A missing symbol is a link error now rather than a load error later.
+  # A missing symbol is a link error now rather than a load error later;
+  # so is a library without GTRACK_PLUGIN, whose two exports the loader
+  # looks for (NO_EXPORT_CHECK: the loader's tests of broken libraries).
   if(NOT APPLE)
     target_link_options(${name} PRIVATE -Wl,--no-undefined)
+    if(NOT ARG_NO_EXPORT_CHECK)
+      target_link_options(${name} PRIVATE -Wl,--require-defined=gtrack_plugin_info
+                          -Wl,--require-defined=gtrack_plugin_create)
+    endif()
   endif()
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${ARG_OUTPUT_DIRECTORY}")
