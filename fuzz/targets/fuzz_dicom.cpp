@@ -21,8 +21,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return 0;
   }
   if (layout.rows <= 0 || layout.columns <= 0 || (layout.samples != 1 && layout.samples != 3)) __builtin_trap();
-  if (layout.frames < 1 || layout.frame_bytes.size() != static_cast<std::size_t>(layout.frames)) __builtin_trap();
-  for (const auto& spans : layout.frame_bytes) {
+  if (layout.frames < 1) __builtin_trap();
+  for (int k = 0; k < layout.frames; ++k) {
+    const auto spans = layout.frame_spans(k);
     if (spans.empty()) __builtin_trap();
     for (const auto& [offset, length] : spans) {
       if (offset > size || length > size - offset) __builtin_trap();

@@ -21,11 +21,14 @@ struct DicomWriteOptions {
   bool preamble = true;          // the 128 bytes, "DICM" and the file meta group
   std::string photometric;       // "" : MONOCHROME2 or RGB by the channels
   int bits_stored = 0;           // 16-bit frames: 0 = 16
+  int high_bit = -1;             // -1: bits_stored - 1
   int planar = 0;                // colour, native: 1 = one plane after another
   double frame_time_ms = 0;      // (0018,1063), 0: none
+  std::string frame_time_vector;  // (0018,1065), "": none
   std::string compress_as;       // ".jpg" or ".jp2": each frame encoded so (transfer syntax to match)
   int fragments_per_frame = 1;   // compressed: each frame's stream split into this many fragments
   bool offset_table = false;     // compressed: a basic offset table with each frame's offset
+  bool strip_jfif = false;       // ".jpg": the JFIF marker taken out, as some scanners write theirs
   bool sequence_before = false;  // an undefined-length sequence before the image tags
   double region_cm_x = 0, region_cm_y = 0;  // > 0: an ultrasound region with this pixel size (cm)
 };
@@ -117,6 +120,7 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
     d.raw(item.bytes());
   }
   if (o.frame_time_ms > 0) d.element(0x0018, 0x1063, "DS", std::to_string(o.frame_time_ms));
+  if (!o.frame_time_vector.empty()) d.element(0x0018, 0x1065, "DS", o.frame_time_vector);
   d.us(0x0028, 0x0002, colour ? 3 : 1);
   d.element(0x0028, 0x0004, "CS", o.photometric.empty() ? (colour ? "RGB" : "MONOCHROME2") : o.photometric);
   if (colour) d.us(0x0028, 0x0006, static_cast<std::uint16_t>(o.planar));
@@ -126,7 +130,8 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
   const int bits = first.depth() == CV_16U ? 16 : 8;
   d.us(0x0028, 0x0100, static_cast<std::uint16_t>(bits));
   d.us(0x0028, 0x0101, static_cast<std::uint16_t>(o.bits_stored > 0 ? o.bits_stored : bits));
-  d.us(0x0028, 0x0102, static_cast<std::uint16_t>((o.bits_stored > 0 ? o.bits_stored : bits) - 1));
+  d.us(0x0028, 0x0102,
+       static_cast<std::uint16_t>(o.high_bit >= 0 ? o.high_bit : (o.bits_stored > 0 ? o.bits_stored : bits) - 1));
   d.us(0x0028, 0x0103, 0);
   if (o.compress_as.empty()) {
     std::string pixels;
@@ -165,6 +170,10 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
     for (const cv::Mat& f : frames) {
       std::vector<unsigned char> encoded;
       cv::imencode(o.compress_as, f, encoded);
+      if (o.strip_jfif && encoded.size() > 6 && encoded[2] == 0xFF && encoded[3] == 0xE0) {
+        const std::size_t app0 = 2 + 2 + ((std::size_t(encoded[4]) << 8) | encoded[5]);
+        encoded.erase(encoded.begin() + 2, encoded.begin() + static_cast<std::ptrdiff_t>(app0));
+      }
       std::string s(encoded.begin(), encoded.end());
       if (s.size() % 2) s += '\0';
       std::vector<std::string> pieces;

@@ -124,15 +124,19 @@ class Reader {
       h.length = u32();
     }
     h.value_at = at_;
-    if (h.length != kUndefined && h.length > size_ - at_) {
+    // (Pixel data and fragments may run past a file cut short: said by the
+    // layout, which reads the whole frames.)
+    if (h.length != kUndefined && h.length > size_ - at_ && h.tag != kPixelData && group != 0xFFFE) {
       fail(start, fmt::format("tag ({:04X},{:04X}) to hold {} bytes; the file has {} after it", h.tag >> 16,
                               h.tag & 0xFFFF, h.length, size_ - at_));
     }
     return h;
   }
 
-  std::string text(const Header& h) {
-    if (h.length == kUndefined || h.length > 4096) fail(h.value_at, "a short text value");
+  std::string text(const Header& h, std::uint32_t limit = 4096) {
+    if (h.length == kUndefined || h.length > limit) {
+      fail_value(h, "a text value of at most " + std::to_string(limit) + " bytes");
+    }
     std::string s(h.length, '\0');
     read(s.data(), h.length);
     return trimmed(s);
@@ -140,18 +144,45 @@ class Reader {
 
   // An unsigned short (US) value.
   int us(const Header& h) {
-    if (h.length != 2) fail(h.value_at, fmt::format("a 2-byte value for tag ({:04X},{:04X})", h.tag >> 16, h.tag & 0xFFFF));
+    if (h.length != 2) fail_value(h, "a 2-byte value");
     return u16();
   }
 
-  // A decimal or integer string (DS, IS): its first value, or none.
-  std::optional<double> decimal(const Header& h) {
-    std::string s = text(h);
-    s = s.substr(0, s.find('\\'));
+  // An 8-byte double (FD).
+  double fd(const Header& h) {
+    if (h.length != 8) fail_value(h, "an 8-byte value");
+    unsigned char b[8];
+    read(b, 8);
+    std::uint64_t bits = 0;
+    for (int i = 7; i >= 0; --i) bits = (bits << 8) | b[i];
     double v = 0;
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+    std::memcpy(&v, &bits, sizeof v);
     return v;
+  }
+
+  // The values of a decimal or integer string (DS, IS), '\\' apart; a value
+  // that is no number is NaN.
+  std::vector<double> decimals(const Header& h, std::uint32_t limit = 4096) {
+    const std::string s = text(h, limit);
+    std::vector<double> out;
+    std::size_t at = 0;
+    for (;;) {
+      const std::size_t end = std::min(s.find('\\', at), s.size());
+      std::string v = trimmed(s.substr(at, end - at));
+      if (!v.empty() && v.front() == '+') v.erase(0, 1);
+      double x = std::numeric_limits<double>::quiet_NaN();
+      const auto [stop, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+      if (v.empty() || ec != std::errc() || stop != v.data() + v.size() || !std::isfinite(x)) {
+        x = std::numeric_limits<double>::quiet_NaN();
+      }
+      out.push_back(x);
+      if (end >= s.size()) return out;
+      at = end + 1;
+    }
+  }
+  std::optional<double> decimal(const Header& h) {
+    const double v = decimals(h).front();
+    return std::isnan(v) ? std::nullopt : std::optional<double>(v);
   }
 
   // Past a sequence of undefined length (its header just read): items
@@ -188,18 +219,6 @@ class Reader {
     skip_sequence(explicit_vr && !un, depth);
   }
 
-  // An 8-byte double (FD).
-  double fd(const Header& h) {
-    if (h.length != 8) fail(h.value_at, fmt::format("an 8-byte value for tag ({:04X},{:04X})", h.tag >> 16, h.tag & 0xFFFF));
-    unsigned char b[8];
-    read(b, 8);
-    std::uint64_t bits = 0;
-    for (int i = 7; i >= 0; --i) bits = (bits << 8) | b[i];
-    double v = 0;
-    std::memcpy(&v, &bits, sizeof v);
-    return v;
-  }
-
   // The items of a sequence (its header just read), each element handed to
   // `on` (which reads or skips its value), at this level only.
   template <class F>
@@ -224,6 +243,11 @@ class Reader {
     throw InputError(fmt::format("{}: byte {}: expected {} (not a DICOM file, or one cut short)", name_, offset,
                                  expected));
   }
+  // A value of the wrong form in a file that reads as DICOM.
+  [[noreturn]] void fail_value(const Header& h, const std::string& expected) const {
+    throw InputError(fmt::format("{}: byte {}: expected {} for tag ({:04X},{:04X})", name_, h.value_at, expected,
+                                 h.tag >> 16, h.tag & 0xFFFF));
+  }
 
  private:
   std::istream& in_;
@@ -235,7 +259,7 @@ class Reader {
 }  // namespace
 
 std::string transfer_syntax_name(const std::string& uid) {
-  static const std::array<std::pair<const char*, const char*>, 12> kNames = {{
+  static const std::array<std::pair<const char*, const char*>, 25> kNames = {{
       {"1.2.840.10008.1.2", "implicit VR little endian"},
       {"1.2.840.10008.1.2.1", "explicit VR little endian"},
       {"1.2.840.10008.1.2.1.99", "deflated explicit VR little endian"},
@@ -248,18 +272,32 @@ std::string transfer_syntax_name(const std::string& uid) {
       {"1.2.840.10008.1.2.4.81", "JPEG-LS near-lossless"},
       {"1.2.840.10008.1.2.4.90", "JPEG 2000 lossless"},
       {"1.2.840.10008.1.2.4.91", "JPEG 2000"},
+      {"1.2.840.10008.1.2.4.100", "MPEG-2 video"},
+      {"1.2.840.10008.1.2.4.101", "MPEG-2 video, high level"},
+      {"1.2.840.10008.1.2.4.102", "MPEG-4 AVC/H.264 video"},
+      {"1.2.840.10008.1.2.4.103", "MPEG-4 AVC/H.264 video, BD-compatible"},
+      {"1.2.840.10008.1.2.4.104", "MPEG-4 AVC/H.264 video, 2D"},
+      {"1.2.840.10008.1.2.4.105", "MPEG-4 AVC/H.264 video, 3D"},
+      {"1.2.840.10008.1.2.4.106", "MPEG-4 AVC/H.264 video, stereo"},
+      {"1.2.840.10008.1.2.4.107", "HEVC/H.265 video"},
+      {"1.2.840.10008.1.2.4.108", "HEVC/H.265 video, main 10"},
+      {"1.2.840.10008.1.2.4.201", "high-throughput JPEG 2000 lossless"},
+      {"1.2.840.10008.1.2.4.202", "high-throughput JPEG 2000, RPCL lossless"},
+      {"1.2.840.10008.1.2.4.203", "high-throughput JPEG 2000"},
+      {"1.2.840.10008.1.2.5", "RLE lossless"},
   }};
   for (const auto& [u, n] : kNames) {
     if (uid == u) return std::string(n) + " (" + uid + ")";
   }
-  if (uid == "1.2.840.10008.1.2.5") return "RLE lossless (" + uid + ")";
-  return uid;
+  return "transfer syntax " + uid;
 }
 
 bool is_dicom_file(const std::string& spec) {
   std::error_code ec;
   if (!fs::is_regular_file(spec, ec)) return false;
-  std::string ext = fs::path(spec).extension().string();
+  const fs::path p(spec);
+  if (p.filename() == "DICOMDIR") return false;  // an index of other files
+  std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   if (ext == ".dcm" || ext == ".dicom") return true;
   std::ifstream in(spec, std::ios::binary);
@@ -267,14 +305,58 @@ bool is_dicom_file(const std::string& spec) {
   return in.read(magic, sizeof magic) && std::string_view(magic + 128, 4) == "DICM";
 }
 
+std::vector<std::pair<std::uint64_t, std::uint64_t>> DicomLayout::frame_spans(int k) const {
+  if (k < 0 || k >= frames) return {};
+  if (!encapsulated) return {{pixels_at + frame_size * static_cast<std::uint64_t>(k), frame_size}};
+  const std::size_t a = first_fragment.at(static_cast<std::size_t>(k));
+  const std::size_t b =
+      static_cast<std::size_t>(k) + 1 < first_fragment.size() ? first_fragment[static_cast<std::size_t>(k) + 1]
+                                                              : fragments.size();
+  return {fragments.begin() + static_cast<std::ptrdiff_t>(a), fragments.begin() + static_cast<std::ptrdiff_t>(b)};
+}
+
+std::vector<unsigned char> jpeg_marked_rgb(std::vector<unsigned char> stream) {
+  if (stream.size() < 4 || stream[0] != 0xFF || stream[1] != 0xD8) return stream;
+  // The markers up to the frame header: JFIF (APP0) or Adobe (APP14) say
+  // how the decoder takes three components; without them, the ids do.
+  std::size_t at = 2;
+  while (at + 4 <= stream.size() && stream[at] == 0xFF) {
+    const unsigned char m = stream[at + 1];
+    const std::size_t length = (std::size_t(stream[at + 2]) << 8) | stream[at + 3];
+    if (m == 0xE0 && at + 9 <= stream.size() && std::equal(stream.begin() + at + 4, stream.begin() + at + 9, "JFIF")) {
+      return stream;
+    }
+    if (m == 0xEE && at + 9 <= stream.size() && std::equal(stream.begin() + at + 4, stream.begin() + at + 9, "Adobe")) {
+      return stream;
+    }
+    const bool frame_header = m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC;
+    if (frame_header) {
+      // Components: count at +9, then (id, sampling, table) triples.
+      if (at + 10 > stream.size() || stream[at + 9] != 3 || at + 10 + 9 > stream.size()) return stream;
+      const unsigned char* ids = stream.data() + at + 10;
+      if (ids[0] == 'R' && ids[3] == 'G' && ids[6] == 'B') return stream;
+      break;
+    }
+    if (m == 0xDA || length < 2) return stream;  // scan data before a frame header: not ours to mend
+    at += 2 + length;
+  }
+  // Adobe APP14, transform 0 (RGB), after SOI.
+  static const unsigned char kAdobe[] = {0xFF, 0xEE, 0x00, 0x0E, 'A', 'd', 'o', 'b', 'e',
+                                         0x00, 0x64, 0x00, 0x00, 0x00, 0x00, 0x00};
+  stream.insert(stream.begin() + 2, std::begin(kAdobe), std::end(kAdobe));
+  return stream;
+}
+
 DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   Reader r(in, name);
   DicomLayout out;
   out.transfer_syntax = kImplicitLittle;  // a bare dataset, without the file meta group
   char magic[132] = {};
+  bool bare = true;
   if (r.size() >= sizeof magic) {
     r.read(magic, sizeof magic);
     if (std::string_view(magic + 128, 4) == "DICM") {
+      bare = false;
       // The file meta group: explicit VR little endian, group 0002 only.
       for (;;) {
         const std::uint64_t start = r.at();
@@ -289,24 +371,40 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
           r.skip_value(h, true, 1);
         }
       }
-    } else {
+    }
+  }
+  if (bare) {
+    // A bare dataset: explicit VR when its first element has one.
+    r.seek(0);
+    if (r.size() >= 6) {
+      char head[6];
+      r.read(head, 6);
+      if (std::isupper(static_cast<unsigned char>(head[4])) && std::isupper(static_cast<unsigned char>(head[5]))) {
+        out.transfer_syntax = kExplicitLittle;
+      }
       r.seek(0);
     }
   }
   const std::string& ts = out.transfer_syntax;
   const bool explicit_vr = ts != kImplicitLittle;
   const bool native = ts == kImplicitLittle || ts == kExplicitLittle;
-  static const std::array<const char*, 6> kCompressed = {"1.2.840.10008.1.2.4.50", "1.2.840.10008.1.2.4.51",
-                                                         "1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91",
-                                                         "1.2.840.10008.1.2.4.57", "1.2.840.10008.1.2.4.70"};
+  static const std::array<const char*, 4> kCompressed = {"1.2.840.10008.1.2.4.50", "1.2.840.10008.1.2.4.51",
+                                                         "1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91"};
   if (!native && std::find(kCompressed.begin(), kCompressed.end(), ts) == kCompressed.end()) {
+    const bool video = ts.rfind("1.2.840.10008.1.2.4.10", 0) == 0;
     throw InputError(name + ": its pixels are stored as " + transfer_syntax_name(ts) +
-                     "; expected native pixels (explicit or implicit VR little endian), JPEG or JPEG 2000 (convert "
-                     "it, e.g. gdcmconv --raw in.dcm out.dcm)");
+                     "; expected native pixels (explicit or implicit VR little endian), JPEG (baseline or extended) "
+                     "or JPEG 2000 (" +
+                     (video ? "the pixel data is a video stream: extract it, e.g. with gdcmraw -t 7fe0,0010, and give "
+                              "the video as --input"
+                            : "convert it, e.g. gdcmconv --raw in.dcm out.dcm") +
+                     ")");
   }
   out.encapsulated = !native;
 
   double frame_time_ms = 0, cine_rate = 0, display_rate = 0;
+  std::vector<double> frame_time_vector;
+  std::vector<std::uint64_t> extended_offsets;
   std::optional<Header> pixels;
   while (!r.at_end()) {
     const Header h = r.header(explicit_vr);
@@ -320,37 +418,66 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
       case tag(0x0028, 0x0002): out.samples = r.us(h); break;
       case tag(0x0028, 0x0100): out.bits_allocated = r.us(h); break;
       case tag(0x0028, 0x0101): out.bits_stored = r.us(h); break;
-      case tag(0x0028, 0x0103): out.is_signed = r.us(h) != 0; break;
+      case tag(0x0028, 0x0102): out.high_bit = r.us(h); break;
+      case tag(0x0028, 0x0103): {
+        if (r.us(h) != 0 && native) {
+          throw InputError(name + ": signed samples (0028,0103 PixelRepresentation 1); expected unsigned ones, as "
+                                  "B-mode images are");
+        }
+        break;
+      }
       case tag(0x0028, 0x0006): out.planar = r.us(h); break;
       case tag(0x0028, 0x0004): out.photometric = r.text(h); break;
       case tag(0x0028, 0x0008): {
         const double n = r.decimal(h).value_or(-1);
-        if (!(n >= 1 && n <= 1e7)) r.fail(h.value_at, "a number of frames (0028,0008) from 1 to 10^7");
+        if (!(n >= 1 && n <= 1e6 && n == std::floor(n))) r.fail_value(h, "a number of frames from 1 to 10^6");
         out.frames = static_cast<int>(n);
         break;
       }
       case tag(0x0018, 0x1063): frame_time_ms = r.decimal(h).value_or(0); break;
+      case tag(0x0018, 0x1065): frame_time_vector = r.decimals(h, 1u << 24); break;
       case tag(0x0018, 0x0040): cine_rate = r.decimal(h).value_or(0); break;
       case tag(0x0008, 0x2144): display_rate = r.decimal(h).value_or(0); break;
+      case tag(0x7FE0, 0x0001): {
+        // Extended offset table: 8-byte offsets, one per frame.
+        if (h.length == kUndefined || h.length % 8 != 0 || h.length > (8u << 20)) {
+          r.fail_value(h, "8-byte offsets, at most 2^20");
+        }
+        for (std::uint32_t i = 0; i < h.length; i += 8) {
+          const std::uint64_t lo = r.u32();
+          extended_offsets.push_back(lo | (std::uint64_t(r.u32()) << 32));
+        }
+        break;
+      }
       case tag(0x0018, 0x6011): {
-        // Sequence of ultrasound regions: the first one's pixel size.
-        int units = 0;
-        double dx = 0, dy = 0;
+        // Sequence of ultrasound regions: the first 2D one's pixel size, in
+        // cm on both axes.
         const bool un = h.vr[0] == 'U' && h.vr[1] == 'N';  // a sequence of VR UN holds implicit VR
+        struct Region {
+          int format = -1, units_x = 0, units_y = 0;
+          double dx = 0, dy = 0;
+        };
+        std::vector<Region> regions;
         r.items(h, explicit_vr && !un, [&](int item, const Header& e) {
-          if (item == 0 && e.tag == tag(0x0018, 0x6024)) {
-            units = r.us(e);
-          } else if (item == 0 && e.tag == tag(0x0018, 0x602C)) {
-            dx = r.fd(e);
-          } else if (item == 0 && e.tag == tag(0x0018, 0x602E)) {
-            dy = r.fd(e);
-          } else {
-            r.skip_value(e, explicit_vr && !un, 2);
+          if (static_cast<int>(regions.size()) <= item) regions.resize(static_cast<std::size_t>(item) + 1);
+          Region& g = regions[static_cast<std::size_t>(item)];
+          switch (e.tag) {
+            case tag(0x0018, 0x6012): g.format = r.us(e); break;
+            case tag(0x0018, 0x6024): g.units_x = r.us(e); break;
+            case tag(0x0018, 0x6026): g.units_y = r.us(e); break;
+            case tag(0x0018, 0x602C): g.dx = r.fd(e); break;
+            case tag(0x0018, 0x602E): g.dy = r.fd(e); break;
+            default: r.skip_value(e, explicit_vr && !un, 2);
           }
         });
-        if (units == 3 && dx > 0 && dy > 0 && std::isfinite(dx) && std::isfinite(dy)) {  // cm
-          out.region_mm_x = 10 * dx;
-          out.region_mm_y = 10 * dy;
+        for (const Region& g : regions) {
+          // Format 1: 2D (tissue); absent: taken as 2D. Units 3: cm.
+          const bool spatial = (g.format == 1 || g.format == -1) && g.units_x == 3 && (g.units_y == 3 || g.units_y == 0);
+          if (spatial && g.dx > 0 && g.dy > 0 && std::isfinite(g.dx) && std::isfinite(g.dy)) {
+            out.region_mm_x = 10 * g.dx;
+            out.region_mm_y = 10 * g.dy;
+            break;
+          }
         }
         break;
       }
@@ -358,7 +485,7 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
     }
   }
   if (!pixels) throw InputError(name + ": holds no pixel data (7FE0,0010); expected an image");
-  if (out.rows <= 0 || out.columns <= 0 || out.rows > 65535 || out.columns > 65535) {
+  if (out.rows <= 0 || out.columns <= 0) {
     throw InputError(name + ": rows and columns (0028,0010-0011) are " + std::to_string(out.rows) + " and " +
                      std::to_string(out.columns) + "; expected an image of 1 to 65535 each");
   }
@@ -366,88 +493,147 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
     throw InputError(name + ": " + std::to_string(out.samples) +
                      " samples per pixel (0028,0002); expected 1 (grey) or 3 (colour)");
   }
+  const std::string& pi = out.photometric;
+  if (pi == "PALETTE COLOR") {
+    throw InputError(name + ": palette colour pixels (0028,0004 PALETTE COLOR); expected grey or colour ones");
+  }
   if (frame_time_ms > 0) {
     out.fps = 1000.0 / frame_time_ms;
+  } else if (frame_time_vector.size() > 1) {
+    // The time from each frame to the next; the first entry is 0.
+    double sum = 0;
+    for (std::size_t i = 1; i < frame_time_vector.size(); ++i) sum += frame_time_vector[i];
+    const double mean = sum / static_cast<double>(frame_time_vector.size() - 1);
+    if (mean > 0) out.fps = 1000.0 / mean;
   } else if (cine_rate > 0) {
     out.fps = cine_rate;
   } else if (display_rate > 0) {
     out.fps = display_rate;
   }
   if (!std::isfinite(out.fps) || out.fps > 1e6) out.fps = 0;
+  const auto cut = [&](int whole, const std::string& why) {
+    if (whole <= 0) throw InputError(name + ": " + why + "; expected at least one whole frame (a file cut short?)");
+    out.cut_short = why + "; its first " + std::to_string(whole) + " frame" + (whole == 1 ? "" : "s") + " are read";
+    out.frames = whole;
+  };
 
   if (!out.encapsulated) {
     if (out.bits_allocated != 8 && out.bits_allocated != 16) {
       throw InputError(name + ": " + std::to_string(out.bits_allocated) +
                        " bits allocated per sample (0028,0100); expected 8 or 16");
     }
-    if (pixels->length == kUndefined) r.fail(pixels->value_at, "native pixel data of a defined length");
+    const bool grey = out.samples == 1 && (pi.empty() || pi == "MONOCHROME1" || pi == "MONOCHROME2");
+    const bool colour = out.samples == 3 && (pi == "RGB" || pi == "YBR_FULL" || pi == "YBR_FULL_422");
+    if (!grey && !colour) {
+      throw InputError(name + ": " + std::to_string(out.samples) + " sample(s) per pixel in photometric "
+                       "interpretation '" + pi + "' (0028,0004); expected MONOCHROME1 or MONOCHROME2 (grey), or "
+                       "RGB, YBR_FULL or YBR_FULL_422 (colour)");
+    }
     // YBR_FULL_422: two pixels in four bytes (Y, Y, Cb, Cr).
-    const bool ybr_422 = out.photometric == "YBR_FULL_422" && out.samples == 3;
+    const bool ybr_422 = pi == "YBR_FULL_422";
     if (ybr_422 && (out.bits_allocated != 8 || out.columns % 2 != 0)) {
       throw InputError(name + ": YBR_FULL_422 pixels of " + std::to_string(out.bits_allocated) + " bits in rows of " +
                        std::to_string(out.columns) + "; expected 8 bits and an even number of columns");
     }
-    const std::uint64_t frame = std::uint64_t(out.rows) * std::uint64_t(out.columns) *
-                                std::uint64_t(ybr_422 ? 2 : out.samples) * std::uint64_t(out.bits_allocated / 8);
-    const std::uint64_t needed = frame * std::uint64_t(out.frames);
-    if (pixels->length < needed) {
-      throw InputError(fmt::format("{}: its pixel data holds {} bytes; {} frame(s) of {}x{}, {} sample(s) of {} bits "
-                                   "need {} (a file cut short?)",
-                                   name, pixels->length, out.frames, out.columns, out.rows, out.samples,
-                                   out.bits_allocated, needed));
+    if (out.bits_stored > out.bits_allocated || out.high_bit >= out.bits_allocated ||
+        (out.high_bit >= 0 && out.bits_stored > 0 && out.high_bit + 1 < out.bits_stored)) {
+      throw InputError(name + ": " + std::to_string(out.bits_stored) + " bits stored with high bit " +
+                       std::to_string(out.high_bit) + " (0028,0101-0102) in " + std::to_string(out.bits_allocated) +
+                       " allocated; expected the stored bits within the allocated ones");
     }
-    for (int k = 0; k < out.frames; ++k) out.frame_bytes.push_back({{pixels->value_at + frame * std::uint64_t(k), frame}});
+    if (pixels->length == kUndefined) r.fail(pixels->value_at, "native pixel data of a defined length");
+    out.pixels_at = pixels->value_at;
+    out.frame_size = std::uint64_t(out.rows) * std::uint64_t(out.columns) * std::uint64_t(ybr_422 ? 2 : out.samples) *
+                     std::uint64_t(out.bits_allocated / 8);
+    const std::uint64_t needed = out.frame_size * std::uint64_t(out.frames);
+    const std::uint64_t held = std::min<std::uint64_t>(pixels->length, r.size() - pixels->value_at);
+    if (held < needed) {
+      cut(static_cast<int>(held / out.frame_size),
+          fmt::format("its pixel data holds {} bytes; {} frame(s) of {}x{}, {} sample(s) of {} bits need {}", held,
+                      out.frames, out.columns, out.rows, out.samples, out.bits_allocated, needed));
+    }
     return out;
   }
 
   // Encapsulated: a basic offset table item, then the fragments, then the
   // sequence's end.
   if (pixels->length != kUndefined) r.fail(pixels->value_at, "encapsulated pixel data of undefined length");
-  std::vector<std::uint32_t> offsets;
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> fragments;
+  std::vector<std::uint64_t> offsets;
   bool first = true;
+  std::string ended;
   for (;;) {
+    if (r.size() - r.at() < 8) {
+      ended = "its compressed pixel data ends before its end mark (FFFE,E0DD)";
+      break;
+    }
     const Header h = r.header(false);
     if (h.tag == kSequenceEnd) break;
     if (h.tag != kItem || h.length == kUndefined) {
       r.fail(h.value_at - 8, "a fragment item (FFFE,E000) of defined length, or the pixel data's end (FFFE,E0DD)");
     }
+    if (h.length > r.size() - h.value_at) {
+      ended = "its compressed pixel data ends within a fragment";
+      break;
+    }
     if (first) {
+      if (h.length / 4 > 1'000'000) r.fail(h.value_at, "a basic offset table of at most 10^6 entries");
       for (std::uint32_t i = 0; i + 4 <= h.length; i += 4) offsets.push_back(r.u32());
       r.seek(h.value_at + h.length);
       first = false;
       continue;
     }
-    if (fragments.size() >= 10'000'000) r.fail(h.value_at, "at most 10^7 fragments");
-    fragments.emplace_back(h.value_at, h.length);
+    if (out.fragments.size() >= 10'000'000) r.fail(h.value_at, "at most 10^7 fragments");
+    out.fragments.emplace_back(h.value_at, h.length);
     r.seek(h.value_at + h.length);
   }
-  if (fragments.empty()) throw InputError(name + ": its compressed pixel data holds no fragment; expected a frame");
+  if (offsets.empty()) offsets = extended_offsets;
+  if (out.fragments.empty()) throw InputError(name + ": its compressed pixel data holds no fragment; expected a frame");
+  const std::size_t frames = static_cast<std::size_t>(out.frames);
   if (out.frames == 1) {
-    out.frame_bytes.push_back(fragments);
-  } else if (static_cast<int>(fragments.size()) == out.frames) {
-    for (const auto& f : fragments) out.frame_bytes.push_back({f});
-  } else if (static_cast<int>(offsets.size()) == out.frames) {
+    out.first_fragment = {0};
+  } else if (out.fragments.size() == frames) {
+    for (std::size_t k = 0; k < frames; ++k) out.first_fragment.push_back(k);
+  } else if (offsets.size() == frames) {
     // The offset table gives each frame's first fragment, counted from the
     // first fragment's item header (8 bytes before its value).
-    const std::uint64_t base = fragments.front().first - 8;
-    out.frame_bytes.assign(static_cast<std::size_t>(out.frames), {});
+    const std::uint64_t base = out.fragments.front().first - 8;
     std::size_t f = 0;
-    for (int k = 0; k < out.frames; ++k) {
-      const std::uint64_t end = k + 1 < out.frames ? base + offsets[static_cast<std::size_t>(k) + 1]
-                                                   : std::numeric_limits<std::uint64_t>::max();
-      if (k > 0 && offsets[static_cast<std::size_t>(k)] <= offsets[static_cast<std::size_t>(k) - 1]) {
-        throw InputError(name + ": its basic offset table is not in increasing order; expected one offset per frame");
+    for (std::size_t k = 0; k < frames; ++k) {
+      if (k > 0 && offsets[k] <= offsets[k - 1]) {
+        throw InputError(name + ": its offset table is not in increasing order; expected one offset per frame");
       }
-      while (f < fragments.size() && fragments[f].first - 8 < end) out.frame_bytes[static_cast<std::size_t>(k)].push_back(fragments[f++]);
-      if (out.frame_bytes[static_cast<std::size_t>(k)].empty()) {
-        throw InputError(name + ": frame " + std::to_string(k) + " has no fragment in its basic offset table");
+      while (f < out.fragments.size() && out.fragments[f].first - 8 < base + offsets[k]) ++f;
+      if (f >= out.fragments.size() && !ended.empty()) break;  // cut short: the frames before
+      if (f >= out.fragments.size() || out.fragments[f].first - 8 != base + offsets[k]) {
+        throw InputError(name + ": frame " + std::to_string(k) + "'s offset in its offset table is no fragment's");
       }
+      out.first_fragment.push_back(f);
     }
   } else {
-    throw InputError(fmt::format("{}: {} frames in {} compressed fragments, and a basic offset table of {} entries; "
-                                 "expected one fragment per frame or an offset per frame",
-                                 name, out.frames, fragments.size(), offsets.size()));
+    // No table: each frame starts with a fragment that starts a stream
+    // (JPEG's FF D8, JPEG 2000's FF 4F or a JP2 box).
+    for (std::size_t f = 0; f < out.fragments.size(); ++f) {
+      unsigned char head[2] = {0, 0};
+      if (out.fragments[f].second >= 2) {
+        r.seek(out.fragments[f].first);
+        r.read(head, 2);
+      }
+      const bool starts = head[0] == 0xFF && (head[1] == 0xD8 || head[1] == 0x4F);
+      const bool jp2_box = head[0] == 0x00 && head[1] == 0x00;
+      if (starts || jp2_box || f == 0) out.first_fragment.push_back(f);
+    }
+    if (out.first_fragment.size() != frames && (ended.empty() || out.first_fragment.size() > frames)) {
+      throw InputError(fmt::format("{}: {} frames in {} compressed fragments, of which {} start a stream, and no "
+                                   "offset table; expected a stream per frame",
+                                   name, out.frames, out.fragments.size(), out.first_fragment.size()));
+    }
+  }
+  if (!ended.empty()) {
+    // A file cut short: the frames whose fragments are all there (the last
+    // one begun may lack some).
+    cut(std::max(0, static_cast<int>(out.first_fragment.size()) - 1), ended);
+    out.fragments.resize(out.first_fragment[static_cast<std::size_t>(out.frames)]);
+    out.first_fragment.resize(static_cast<std::size_t>(out.frames));
   }
   return out;
 }

@@ -18,31 +18,45 @@ struct DicomLayout {
   int samples = 1;         // per pixel: 1 (grey) or 3 (colour)
   int bits_allocated = 8;  // 8 or 16
   int bits_stored = 0;     // 0: as allocated
-  bool is_signed = false;
-  int planar = 0;  // 3 samples: 0 = interleaved, 1 = one plane after the other
+  int high_bit = -1;       // the stored bits' highest; -1: bits_stored - 1
+  int planar = 0;          // 3 samples: 0 = interleaved, 1 = one plane after the other
   int frames = 1;
   std::string photometric;      // MONOCHROME2, RGB, YBR_FULL_422, ...
   std::string transfer_syntax;  // its UID
   bool encapsulated = false;    // compressed: each frame's fragments are a JPEG or JPEG 2000 stream
-  double fps = 0;               // from the frame time or the cine rate; 0 when the file gives none
-  // The first ultrasound region's pixel size (0018,6011: PhysicalDeltaX and
-  // Y in cm), in mm; 0 when the file gives none.
+  double fps = 0;               // from the frame time (vector) or the cine rate; 0 when the file gives none
+  // The first 2D ultrasound region's pixel size (0018,6011: PhysicalDeltaX
+  // and Y in cm), in mm; 0 when the file gives none.
   double region_mm_x = 0, region_mm_y = 0;
-  // Each frame's bytes: (offset in the file, length) spans, one for native
-  // pixels, one or more fragments when encapsulated.
-  std::vector<std::vector<std::pair<std::uint64_t, std::uint64_t>>> frame_bytes;
+  // Why the file holds fewer whole frames than it says (cut short), or "".
+  std::string cut_short;
+
+  // Native pixels: where the first frame starts and each frame's size.
+  std::uint64_t pixels_at = 0, frame_size = 0;
+  // Encapsulated: the fragments (offset in the file, length), and each
+  // frame's first fragment (frame k has fragments [first[k], first[k+1])).
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> fragments;
+  std::vector<std::size_t> first_fragment;
+
+  // Frame k's bytes as (offset, length) spans.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> frame_spans(int k) const;
 };
 
 // Reads the layout from the file's start (with its 128-byte preamble and
-// "DICM", or a bare dataset in implicit VR). InputError naming `name`, the
-// byte offset and what was expected, for anything it cannot take.
+// "DICM", or a bare dataset). InputError naming `name` and what was
+// expected, for anything it cannot take.
 DicomLayout read_dicom_layout(std::istream& in, const std::string& name);
 
 // A regular file named .dcm or .dicom (any case), or with "DICM" at byte
-// 128, as scanners export without an extension.
+// 128, as scanners export without an extension (not DICOMDIR, an index).
 bool is_dicom_file(const std::string& spec);
 
 // The transfer syntax by name, for messages ("JPEG baseline (1.2.840...)").
 std::string transfer_syntax_name(const std::string& uid);
+
+// A JPEG stream of RGB samples (no JFIF or Adobe marker, component ids not
+// 'R', 'G', 'B') that a decoder would take as YCbCr: given an Adobe marker
+// that says RGB. Other streams are returned unchanged.
+std::vector<unsigned char> jpeg_marked_rgb(std::vector<unsigned char> stream);
 
 }  // namespace gtrack::detail

@@ -379,12 +379,23 @@ int numbered_next(const fs::path& a, const fs::path& b) {
   return y.numbers[static_cast<size_t>(changed)] == x.numbers[static_cast<size_t>(changed)] + 1 ? 1 : 0;
 }
 
+// The stored bits of native samples, moved down to bit 0 and the bits
+// outside them cleared (a file's own overlay or padding bits).
+template <class T>
+void keep_stored_bits(cv::Mat& image, int shift, int bits) {
+  const T mask = static_cast<T>((1u << bits) - 1u);
+  for (int y = 0; y < image.rows; ++y) {
+    T* row = image.ptr<T>(y);
+    for (int x = 0; x < image.cols * image.channels(); ++x) row[x] = static_cast<T>((row[x] >> shift) & mask);
+  }
+}
+
 // Frame `k` of a DICOM file as an image OpenCV can take: 8 bits per sample
 // (16-bit samples scaled by the bits the file says it stores), grey or BGR.
 cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, int k, const std::string& name) {
   const std::string what = name + " frame " + std::to_string(k);
   std::vector<unsigned char> bytes;
-  for (const auto& [offset, length] : layout.frame_bytes.at(static_cast<std::size_t>(k))) {
+  for (const auto& [offset, length] : layout.frame_spans(k)) {
     const std::size_t at = bytes.size();
     bytes.resize(at + length);
     in.clear();
@@ -396,6 +407,10 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
   const std::string& pi = layout.photometric;
   cv::Mat image;
   if (layout.encapsulated) {
+    // A JPEG of RGB samples that says so only in the DICOM header.
+    const bool jpeg = layout.transfer_syntax == "1.2.840.10008.1.2.4.50" ||
+                      layout.transfer_syntax == "1.2.840.10008.1.2.4.51";
+    if (jpeg && pi == "RGB") bytes = detail::jpeg_marked_rgb(std::move(bytes));
     detail::CapturedStderr library;
     try {
       image = cv::imdecode(bytes, cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
@@ -409,11 +424,9 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
                        "; convert the file to native pixels, e.g. gdcmconv --raw in.dcm out.dcm");
     }
   } else {
-    if (layout.is_signed && layout.bits_allocated == 16) {
-      throw InputError(name + ": signed 16-bit samples (0028,0103); expected unsigned ones, as B-mode images are");
-    }
+    // The layout took only what these cases read.
     const int depth = layout.bits_allocated == 16 ? CV_16U : CV_8U;
-    if (layout.samples == 3 && pi == "YBR_FULL_422") {
+    if (pi == "YBR_FULL_422") {
       // Each two pixels: Y0, Y1, Cb, Cr (8 bits, checked with the layout).
       image.create(layout.rows, layout.columns, CV_8UC3);  // Y, Cr, Cb, OpenCV's order
       const unsigned char* in_px = bytes.data();
@@ -425,23 +438,32 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
         }
       }
       cv::cvtColor(image, image, cv::COLOR_YCrCb2BGR);
-    } else if (layout.samples == 1) {
-      image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data()).clone();
-    } else if (layout.planar == 1) {
-      const std::size_t plane = bytes.size() / 3;
-      std::vector<cv::Mat> planes;
-      for (int c = 0; c < 3; ++c) {
-        planes.emplace_back(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data() + plane * c);
-      }
-      cv::merge(planes, image);
     } else {
-      image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 3), bytes.data()).clone();
-    }
-    if (layout.samples == 3) {
+      if (layout.samples == 1) {
+        image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data()).clone();
+      } else if (layout.planar == 1) {
+        const std::size_t plane = bytes.size() / 3;
+        std::vector<cv::Mat> planes;
+        for (int c = 0; c < 3; ++c) {
+          planes.emplace_back(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data() + plane * c);
+        }
+        cv::merge(planes, image);
+      } else {
+        image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 3), bytes.data()).clone();
+      }
+      const int allocated = layout.bits_allocated;
+      const int stored = layout.bits_stored > 0 ? layout.bits_stored : allocated;
+      const int shift = layout.high_bit >= 0 ? layout.high_bit + 1 - stored : 0;
+      if (shift > 0 || stored < allocated) {
+        if (depth == CV_16U) {
+          keep_stored_bits<std::uint16_t>(image, shift, stored);
+        } else {
+          keep_stored_bits<std::uint8_t>(image, shift, stored);
+        }
+        if (depth == CV_8U) image.convertTo(image, CV_8U, 255.0 / (std::ldexp(1.0, stored) - 1.0));
+      }
       if (pi == "RGB") {
         cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
-      } else if (pi == "YBR_FULL_422") {
-        // Converted above.
       } else if (pi == "YBR_FULL") {
         // Y, Cb, Cr; OpenCV's order is Y, Cr, Cb.
         std::vector<cv::Mat> ycc;
@@ -449,13 +471,7 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
         std::swap(ycc[1], ycc[2]);
         cv::merge(ycc, image);
         cv::cvtColor(image, image, cv::COLOR_YCrCb2BGR);
-      } else {
-        throw InputError(name + ": colour pixels in photometric interpretation '" + pi +
-                         "' (0028,0004); expected RGB, YBR_FULL or YBR_FULL_422 (or a compressed file)");
       }
-    } else if (!pi.empty() && pi != "MONOCHROME1" && pi != "MONOCHROME2") {
-      throw InputError(name + ": grey pixels in photometric interpretation '" + pi +
-                       "' (0028,0004); expected MONOCHROME1 or MONOCHROME2");
     }
   }
   if (image.depth() == CV_16U) {
@@ -467,12 +483,13 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
   return image;
 }
 
-// A folder's image named .dcm or .dicom: a single-frame DICOM file (one
-// file per frame, as some scanners export), decoded as a DICOM file's
-// frames are; what cannot be read is said in `said` and gives no image.
+// A folder's image named .dcm or .dicom, or without an extension (listed
+// only when it is DICOM): a single-frame DICOM file (one file per frame,
+// as scanners export), decoded as a DICOM file's frames are; what cannot
+// be read is said in `said` and gives no image.
 bool is_dicom_name(const fs::path& p) {
   const std::string ext = lowercase_extension(p);
-  return ext == ".dcm" || ext == ".dicom";
+  return ext == ".dcm" || ext == ".dicom" || ext.empty();  // a folder lists no other file without an extension
 }
 cv::Mat read_dicom_image(const fs::path& p, std::string& said) {
   try {
@@ -497,7 +514,9 @@ class FolderSource final : public FrameSource {
       : dir_(dir), expected_(expected), filter_(range), fps_(fps), follow_(follow) {
     scan();
     if (files_.empty() && !following()) {
-      throw InputError(dir.string() + ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm, .dcm)");
+      throw InputError(dir.string() +
+                       ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm, .dcm, or DICOM files "
+                       "without an extension)");
     }
   }
 
@@ -598,7 +617,18 @@ class FolderSource final : public FrameSource {
       // or an image still being written under a temporary name.
       if (name.front() == '.') continue;
       const std::string ext = lowercase_extension(it->path());
-      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) found.push_back(it->path());
+      if (std::find(exts.begin(), exts.end(), ext) != exts.end()) {
+        found.push_back(it->path());
+      } else if (ext.empty()) {
+        // A scanner's export names its DICOM files IM_0001, ... : "DICM"
+        // at byte 128 says what they are. One too short to say yet (being
+        // written) is looked at again.
+        if (detail::is_dicom_file(it->path().string())) {
+          found.push_back(it->path());
+        } else if (following() && fs::file_size(it->path(), entry_ec) < 132) {
+          seen.pop_back();
+        }
+      }
     }
     if (ec) {
       // Following, a listing that fails is made again, whole, at the next poll.
@@ -780,6 +810,8 @@ class FolderSource final : public FrameSource {
   }
 
   [[noreturn]] static void fail_to_read(const fs::path& p, const std::string& said) {
+    // A DICOM file's reader names the file and what it expected.
+    if (is_dicom_name(p) && said.rfind(p.string() + ":", 0) == 0) throw InputError(said);
     throw InputError(p.string() + ": cannot read the image (corrupt or unsupported format" +
                      (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
   }
@@ -1052,6 +1084,7 @@ class DicomSource final : public FrameSource {
     if (!in_) throw InputError(spec_ + ": cannot open the file");
     layout_ = detail::read_dicom_layout(in_, spec_);
     fps_ = layout_.fps > 0 ? layout_.fps : fallback_fps;
+    if (!layout_.cut_short.empty()) logger().warn("{}: {}", spec_, layout_.cut_short);
     index_ = std::max(0, range.first);
     logger().debug("{}: DICOM, {} frame(s) of {}x{}, {} sample(s) of {} bits, {}, {}, {} frames/s", spec_,
                    layout_.frames, layout_.columns, layout_.rows, layout_.samples, layout_.bits_allocated,
@@ -1072,6 +1105,7 @@ class DicomSource final : public FrameSource {
   }
   double fps() const override { return fps_; }
   int frame_count() const override { return layout_.frames; }
+  std::string ended_early() const override { return layout_.cut_short; }
   std::optional<std::pair<double, double>> pixel_size_mm() const override {
     if (!(layout_.region_mm_x > 0 && layout_.region_mm_y > 0)) return std::nullopt;
     return std::make_pair(layout_.region_mm_x, layout_.region_mm_y);
