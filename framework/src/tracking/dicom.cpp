@@ -611,16 +611,21 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
     }
   } else {
     // No table: each frame starts with a fragment that starts a stream
-    // (JPEG's FF D8, JPEG 2000's FF 4F or a JP2 box).
+    // (JPEG's FF D8 FF, a JPEG 2000 codestream's FF 4F FF 51, or a JP2
+    // file's signature box).
+    static const unsigned char kJpeg[] = {0xFF, 0xD8, 0xFF}, kJ2k[] = {0xFF, 0x4F, 0xFF, 0x51},
+                               kJp2[] = {0x00, 0x00, 0x00, 0x0C, 0x6A, 0x50, 0x20, 0x20};
     for (std::size_t f = 0; f < out.fragments.size(); ++f) {
-      unsigned char head[2] = {0, 0};
-      if (out.fragments[f].second >= 2) {
-        r.seek(out.fragments[f].first);
-        r.read(head, 2);
+      unsigned char head[8] = {};
+      const std::uint64_t n = std::min<std::uint64_t>(8, out.fragments[f].second);
+      r.seek(out.fragments[f].first);
+      r.read(head, n);
+      const auto starts_with = [&](const unsigned char* sig, std::size_t len) {
+        return n >= len && std::equal(sig, sig + len, head);
+      };
+      if (f == 0 || starts_with(kJpeg, 3) || starts_with(kJ2k, 4) || starts_with(kJp2, 8)) {
+        out.first_fragment.push_back(f);
       }
-      const bool starts = head[0] == 0xFF && (head[1] == 0xD8 || head[1] == 0x4F);
-      const bool jp2_box = head[0] == 0x00 && head[1] == 0x00;
-      if (starts || jp2_box || f == 0) out.first_fragment.push_back(f);
     }
     if (out.first_fragment.size() != frames && (ended.empty() || out.first_fragment.size() > frames)) {
       throw InputError(fmt::format("{}: {} frames in {} compressed fragments, of which {} start a stream, and no "
