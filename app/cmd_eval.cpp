@@ -244,7 +244,8 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   opt.out_of_view_below = vm["out-of-view-below"].as<double>();
   opt.off_track_endpoint_um = vm["off-track-um"].as<double>();
   // An ultrasound slice does not show where within its slab the gripper
-  // lies: off track is judged within the imaging plane.
+  // lies: off track is judged within the imaging plane; so it is for a
+  // camera with --off-track-in-plane.
   opt.off_track_in_plane = gtrack::cli::images_a_slab(*setup.sensor) || vm.count("off-track-in-plane") > 0;
   if (!(opt.out_of_view_below >= 0 && opt.out_of_view_below < 1)) {
     throw gtrack::cli::UsageError("--out-of-view-below must be a share in [0, 1)");

@@ -176,7 +176,7 @@ GTRACK_COMMAND(
     "segment", "show what a config's [observation] bounds take for the gripper in whole frames, to choose them",
     [](po::options_description& d) {
       d.add_options()("config,c", po::value<std::string>()->required(), "TOML config (its [observation] bounds)")(
-          "input,i", po::value<std::string>()->required(), "video, image folder or TIFF stack")(
+          "input,i", po::value<std::string>()->required(), "video, image folder, TIFF stack or DICOM file")(
           "out,o", po::value<std::string>()->required(), "folder to write masks/ and preview/ into")(
           "frames", po::value<std::string>(),
           "A:B, frames A (inclusive) to B (exclusive); A: and :B open-ended; A alone: that frame")(

@@ -1,4 +1,4 @@
-// gtrack track: the tracker over a video, an image folder or a camera.
+// gtrack track: the tracker over a video, an image folder, a stack, a DICOM file or a camera.
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -233,10 +233,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
 }  // namespace
 
 GTRACK_COMMAND(
-    "track", "track a gripper in a video, an image folder, a TIFF stack or a live camera",
+    "track", "track a gripper in a video, an image folder, a TIFF stack, a DICOM file or a live camera",
     [](po::options_description& d) {
       d.add_options()("config,c", po::value<std::string>()->required(), "TOML config naming sensor, gripper, stimulus")(
-          "input,i", po::value<std::string>()->required(), "video file, folder of images, TIFF stack, or camera:N")(
+          "input,i", po::value<std::string>()->required(), "video file, folder of images, TIFF stack, DICOM file (a cine loop), or camera:N")(
           "stimulus,s", po::value<std::string>(), "stimulus log CSV (frame,value or time_s,value)")(
           "stimulus-column", po::value<std::string>(),
           "of a stimulus log with several named columns (time_s,B_mT,T_C), the one that holds the readings")(

@@ -9,6 +9,12 @@ function(gtrack_add_plugin name)
   if(NOT ARG_KIND MATCHES "^(sensor|gripper|stimulus)$")
     message(FATAL_ERROR "gtrack_add_plugin(${name}): KIND must be sensor, gripper or stimulus, got '${ARG_KIND}'")
   endif()
+  # The name is the library's file name part, libgtrack_<name>.so, and what
+  # a config's plugin key gives: the loader's rule.
+  if(NOT name MATCHES "^[A-Za-z0-9_-]+$")
+    message(FATAL_ERROR "gtrack_add_plugin(${name}): the name must be letters, digits, '_' and '-' (the config's "
+                        "plugin key and the file libgtrack_<name>.so)")
+  endif()
   if(NOT ARG_SOURCES)
     message(FATAL_ERROR "gtrack_add_plugin(${name}): SOURCES is empty")
   endif()

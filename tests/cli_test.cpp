@@ -670,9 +670,6 @@ std::string truth_as_estimates(const fs::path& truth, int every = 1) {
   return text;
 }
 
-// A run with --frames and --every has no row for the frames it skipped:
-// eval counts them as lost and says which options judge only the others;
-// with them, only those frames are judged.
 // --off-track-in-plane leaves depth out of the off-track judgement: an
 // estimate 300 um deeper than the truth is off track at 200 um in 3D and
 // on track across the viewing axis.
@@ -705,6 +702,9 @@ TEST(Cli, EvalJudgesOffTrackAcrossTheViewingAxisWhenAsked) {
   EXPECT_NE(read_file(dir / "e.json").find("\"off_track_in_plane\": true"), std::string::npos);
 }
 
+// A run with --frames and --every has no row for the frames it skipped:
+// eval counts them as lost and says which options judge only the others;
+// with them, only those frames are judged.
 TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "eval_every";
   fs::remove_all(dir);

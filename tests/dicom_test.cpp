@@ -5,6 +5,7 @@
 #include <gtrack/frame_source.hpp>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gtrack/error.hpp"
@@ -104,7 +106,12 @@ TEST(Dicom, NativeFramesAreTheImagesWrittenAtTheFilesRate) {
   got = read_all(dir / "bare.dcm", {40, 30}, &fps);
   ASSERT_EQ(got.size(), 3u);
   for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], bgr(written[i]))) << "frame " << i;
-  EXPECT_DOUBLE_EQ(fps, 30) << "no frame time: the fallback rate";
+  EXPECT_DOUBLE_EQ(fps, 0) << "no frame time: no rate of its own, as a folder";
+  {
+    auto src = gtrack::open_frame_source((dir / "bare.dcm").string(), {40, 30}, {}, 20);
+    src->next();
+    EXPECT_DOUBLE_EQ(src->next()->time_s, 1.0 / 20) << "its frames' times at the rate taken";
+  }
   DicomWriteOptions vector;
   vector.frame_time_vector = "0\\40\\40";
   write_dicom(dir / "vector.dcm", written, vector);
@@ -161,6 +168,43 @@ TEST(Dicom, AFolderOfSingleFrameFilesIsAFolderOfImages) {
   EXPECT_NE(e.find("IM3.dcm: a DICOM file of 3 frames in a folder of images; give the file itself as --input"),
             std::string::npos)
       << e;
+  // Followed, it is refused at once: no writer will change what it is.
+  const fs::path followed = dir_for("folder_followed");
+  write_dicom(followed / "IM3.dcm", written);
+  gtrack::FollowOptions follow;
+  follow.idle_s = 20;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    gtrack::open_frame_source(followed.string(), {40, 30}, {}, 30, follow)->next();
+    ADD_FAILURE() << "a multi-frame file in a followed folder was taken";
+  } catch (const gtrack::InputError& refused) {
+    EXPECT_EQ(std::string(refused.what()).find("unchanged for"), std::string::npos) << refused.what();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0);
+}
+
+// A followed folder: a scanner's IM_0001 whose size was set before its
+// bytes were written is taken once "DICM" is there, not passed over.
+TEST(Dicom, AFollowedFoldersFileWithoutAnExtensionIsTakenOnceItSaysDicom) {
+  const fs::path dir = dir_for("followed");
+  const fs::path staged = dir_for("followed_staged") / "IM_0001";
+  const auto written = frames(1);
+  write_dicom(staged, written);
+  const auto size = fs::file_size(staged);
+  std::ofstream(dir / "IM_0001", std::ios::binary) << std::string(size, '\0');  // the size first
+  std::thread writer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::ifstream in(staged, std::ios::binary);
+    std::ofstream out(dir / "IM_0001", std::ios::binary | std::ios::in | std::ios::out);
+    out << in.rdbuf();
+  });
+  gtrack::FollowOptions follow;
+  follow.idle_s = 3;
+  auto src = gtrack::open_frame_source(dir.string(), {40, 30}, {}, 30, follow);
+  const auto f = src->next();
+  writer.join();
+  ASSERT_TRUE(f);
+  EXPECT_TRUE(same(f->image, bgr(written[0])));
 }
 
 // Colour (RGB interleaved and planar, YBR_FULL_422), 16-bit samples of 12
@@ -274,6 +318,16 @@ TEST(Dicom, CompressedFramesAreDecodedFrameByFrame) {
   got = read_all(dir / "rgb_jfif.dcm", {64, 48});
   ASSERT_EQ(got.size(), 3u);
   EXPECT_TRUE(same(got[0], jpeg[0]));
+  // Only the end mark missing: every frame is whole, and none is dropped.
+  std::string bytes;
+  {
+    std::ifstream in(dir / "jpeg.dcm", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  std::ofstream(dir / "no_end.dcm", std::ios::binary) << bytes.substr(0, bytes.size() - 8);
+  auto no_end = gtrack::open_frame_source((dir / "no_end.dcm").string(), {64, 48}, {}, 30);
+  EXPECT_EQ(no_end->frame_count(), 3);
+  EXPECT_EQ(no_end->ended_early(), "");
 
   std::vector<unsigned char> probe;
   bool j2k = false;

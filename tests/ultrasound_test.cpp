@@ -4,7 +4,9 @@
 // model (segment-triangle test per pixel, no clipping, no projection matrix).
 #include <gtest/gtest.h>
 
+#include <gtrack/engine_config.hpp>
 #include <gtrack/renderer.hpp>
+#include <gtrack/setup.hpp>
 #include <random>
 
 #include "support/plugins.hpp"
@@ -115,6 +117,21 @@ TEST(UltrasoundSlice, ADepthSpacingOfItsOwnScalesTheRows) {
   EXPECT_DOUBLE_EQ(sensor->mm_per_pixel(), 0.1);
   // The nominal position is at the image's middle row.
   EXPECT_NEAR(sensor->project(sensor->nominal_position_mm())->y(), 331, 1e-9);
+  const Eigen::Vector2d pixel = gtrack::pixel_size_mm(*sensor);
+  EXPECT_DOUBLE_EQ(pixel.x(), 0.1);
+  EXPECT_NEAR(pixel.y(), 0.12, 1e-12);
+  EXPECT_EQ(gtrack::pixel_size_mm(*make_sensor("plugin = \"ultrasound_slice\"")), Eigen::Vector2d(0.09, 0.09))
+      << "square pixels stay exactly mm_per_pixel";
+  // A tall image of tall pixels: the default search box holds its whole
+  // depth (1024 rows of 0.12 mm), not just its width's extent.
+  auto root = gtrack::ConfigTable::parse(
+      "[sensor]\nplugin = \"ultrasound_slice\"\nwidth = 512\nheight = 1024\nmm_per_pixel = 0.1\n"
+      "mm_per_pixel_depth = 0.12\n[gripper]\nplugin = \"hydrogel_six_finger\"\n",
+      "<test>");
+  const gtrack::Setup tall = gtrack::load_setup(root, {});
+  const gtrack::EngineConfig config = gtrack::engine_config(tall);
+  EXPECT_LE(config.search.position_min_mm.y(), 0.0);
+  EXPECT_GE(config.search.position_max_mm.y(), 1024 * 0.12);
 }
 
 }  // namespace

@@ -137,6 +137,10 @@ void warn_if_missing(const fs::path& dir, const char* from) {
 
 }  // namespace
 
+std::string plugin_label(PluginKind kind, const std::string& name, const fs::path& file) {
+  return std::string(to_string(kind)) + " plugin '" + name + "' (" + file.string() + ")";
+}
+
 PluginLoader::PluginLoader(std::vector<fs::path> user_paths) : initial_user_(std::move(user_paths)) {
   for (const auto& p : initial_user_) warn_if_missing(p, "--plugin-path");
   if (const char* env = std::getenv("GTRACK_PLUGIN_PATH"); env && *env) {
@@ -241,11 +245,7 @@ std::vector<fs::path> PluginLoader::set_aside_by(const fs::path& taken) const {
 }
 
 fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
-  // A name is a file name part, never a path: the rule of make()'s check.
-  if (!is_plugin_name(name)) {
-    throw PluginError(std::string(to_string(kind)) + " plugin name '" + name +
-                      "': expected letters, digits, '_' and '-' (a name, not a path; use plugin_path for folders)");
-  }
+  // (make() has checked that the name is a file name part, never a path.)
   for (const auto& dir : paths_) {
     fs::path f = dir / library_file_name(name);
     std::error_code ec;
@@ -297,15 +297,12 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
   } catch (const ConfigError& e) {
     throw ConfigError(e.what());
   } catch (const std::exception& e) {
-    throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
-                      "): could not be created: " + e.what());
+    throw PluginError(plugin_label(kind, name, file) + ": could not be created: " + e.what());
   } catch (...) {
-    throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
-                      "): could not be created: unknown exception");
+    throw PluginError(plugin_label(kind, name, file) + ": could not be created: unknown exception");
   }
   if (!raw) {
-    throw PluginError(to_string(kind) + std::string(" plugin '") + name + "' (" + file.string() +
-                      "): factory returned nothing");
+    throw PluginError(plugin_label(kind, name, file) + ": factory returned nothing");
   }
   // The deleter owns the library as well (keep_loaded's hold ends with the
   // process's static objects): the instance is destroyed while its code is
@@ -324,7 +321,7 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
   logger().debug("loaded {} plugin '{}' {} from {}", to_string(kind), rec.name, rec.version, file.string());
   // A stimulus's results are checked as the tracker takes them.
   if constexpr (std::is_same_v<Interface, Stimulus>) {
-    return std::make_shared<detail::CheckedStimulus>(instance, "stimulus plugin '" + name + "' (" + file.string() + ")");
+    return std::make_shared<detail::CheckedStimulus>(instance, plugin_label(kind, name, file));
   }
   return instance;
 }

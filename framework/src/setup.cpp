@@ -119,7 +119,7 @@ std::string plugin_label(const Setup& setup, PluginKind kind) {
   const std::string label = std::string(to_string(kind)) + " plugin";
   if (!setup.loader) return label;
   for (const PluginRecord& r : setup.loader->loaded()) {
-    if (r.kind == kind) return label + " '" + r.name + "' (" + r.file.string() + ")";
+    if (r.kind == kind) return plugin_label(r.kind, r.name, r.file);
   }
   return label;
 }

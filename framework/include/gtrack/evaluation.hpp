@@ -40,7 +40,9 @@ struct EvalOptions {
   double off_track_endpoint_um = 400;
   // Judge off track by the endpoints' distance across the viewing axis
   // (FrameErrors::endpoint_inplane_um): for an ultrasound slice, whose image
-  // does not show where within its slab the gripper lies.
+  // does not show where within its slab the gripper lies, and for a small
+  // gripper's small threshold, which a camera's depth error alone would
+  // pass (gtrack eval --off-track-in-plane).
   bool off_track_in_plane = false;
 };
 

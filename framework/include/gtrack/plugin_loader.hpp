@@ -29,6 +29,9 @@ struct PluginRecord {
   std::filesystem::path file;
 };
 
+// A plugin as errors name it: "gripper plugin 'name' (file)".
+GTRACK_API std::string plugin_label(PluginKind kind, const std::string& name, const std::filesystem::path& file);
+
 class GTRACK_API PluginLoader {
  public:
   // `user_paths` come first in the search order, then GTRACK_PLUGIN_PATH,

@@ -60,6 +60,11 @@ class GTRACK_API Sensor {
   virtual double mm_per_pixel() const = 0;
 };
 
+// A pixel's width and height in mm: for an affine projection (a slice), the
+// height by the ratio of its rows to its columns (a scanner whose pixels
+// are not square); else mm_per_pixel() for both.
+GTRACK_API Eigen::Vector2d pixel_size_mm(const Sensor& sensor);
+
 // The sensor's viewing axis (unit length): a camera's optical axis, the
 // normal of an orthographic view or an ultrasound slice.
 GTRACK_API Eigen::Vector3d viewing_axis(const Projection& projection);

@@ -164,9 +164,10 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   // Motion and tilts are planned in the sensor's own frame, so that a probe
   // or a camera turned in the world sees the sequence an upright one does.
   const SensorFrame frame = sensor_frame(sensor);
-  const double mmpp = sensor.mm_per_pixel(), radius = model.radius_mm();
+  const double radius = model.radius_mm();
   const ImageSize size = sensor.image_size();
-  const Eigen::Vector2d half_view(0.5 * size.width * mmpp, 0.5 * size.height * mmpp);
+  const Eigen::Vector2d pixel = pixel_size_mm(sensor);
+  const Eigen::Vector2d half_view(0.5 * size.width * pixel.x(), 0.5 * size.height * pixel.y());
   const Eigen::Vector2d room = (half_view.array() - radius).max(0.25 * radius).matrix();
 
   const double base_hz = 1.0 / p.motion_period_s;

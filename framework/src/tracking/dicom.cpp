@@ -243,6 +243,12 @@ class Reader {
     throw InputError(fmt::format("{}: byte {}: expected {} (not a DICOM file, or one cut short)", name_, offset,
                                  expected));
   }
+  // Pixel data not laid out as the transfer syntax says.
+  [[noreturn]] void fail_pixels(std::uint64_t offset, const std::string& expected) const {
+    throw InputError(fmt::format("{}: byte {}: expected {} (the pixel data is not as its transfer syntax, {}, says)",
+                                 name_, offset, expected, transfer_syntax_name(transfer_syntax)));
+  }
+  std::string transfer_syntax;  // for fail_pixels
   // A value of the wrong form in a file that reads as DICOM.
   [[noreturn]] void fail_value(const Header& h, const std::string& expected) const {
     throw InputError(fmt::format("{}: byte {}: expected {} for tag ({:04X},{:04X})", name_, h.value_at, expected,
@@ -392,7 +398,7 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
                                                          "1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91"};
   if (!native && std::find(kCompressed.begin(), kCompressed.end(), ts) == kCompressed.end()) {
     const bool video = ts.rfind("1.2.840.10008.1.2.4.10", 0) == 0;
-    throw InputError(name + ": its pixels are stored as " + transfer_syntax_name(ts) +
+    throw DicomRefusal(name + ": its pixels are stored as " + transfer_syntax_name(ts) +
                      "; expected native pixels (explicit or implicit VR little endian), JPEG (baseline or extended) "
                      "or JPEG 2000 (" +
                      (video ? "the pixel data is a video stream: extract it, e.g. with gdcmraw -t 7fe0,0010, and give "
@@ -401,6 +407,7 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
                      ")");
   }
   out.encapsulated = !native;
+  r.transfer_syntax = ts;
 
   double frame_time_ms = 0, cine_rate = 0, display_rate = 0;
   std::vector<double> frame_time_vector;
@@ -420,8 +427,8 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
       case tag(0x0028, 0x0101): out.bits_stored = r.us(h); break;
       case tag(0x0028, 0x0102): out.high_bit = r.us(h); break;
       case tag(0x0028, 0x0103): {
-        if (r.us(h) != 0 && native) {
-          throw InputError(name + ": signed samples (0028,0103 PixelRepresentation 1); expected unsigned ones, as "
+        if (r.us(h) != 0) {
+          throw DicomRefusal(name + ": signed samples (0028,0103 PixelRepresentation 1); expected unsigned ones, as "
                                   "B-mode images are");
         }
         break;
@@ -486,16 +493,16 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   }
   if (!pixels) throw InputError(name + ": holds no pixel data (7FE0,0010); expected an image");
   if (out.rows <= 0 || out.columns <= 0) {
-    throw InputError(name + ": rows and columns (0028,0010-0011) are " + std::to_string(out.rows) + " and " +
+    throw DicomRefusal(name + ": rows and columns (0028,0010-0011) are " + std::to_string(out.rows) + " and " +
                      std::to_string(out.columns) + "; expected an image of 1 to 65535 each");
   }
   if (out.samples != 1 && out.samples != 3) {
-    throw InputError(name + ": " + std::to_string(out.samples) +
+    throw DicomRefusal(name + ": " + std::to_string(out.samples) +
                      " samples per pixel (0028,0002); expected 1 (grey) or 3 (colour)");
   }
   const std::string& pi = out.photometric;
   if (pi == "PALETTE COLOR") {
-    throw InputError(name + ": palette colour pixels (0028,0004 PALETTE COLOR); expected grey or colour ones");
+    throw DicomRefusal(name + ": palette colour pixels (0028,0004 PALETTE COLOR); expected grey or colour ones");
   }
   if (frame_time_ms > 0) {
     out.fps = 1000.0 / frame_time_ms;
@@ -519,29 +526,29 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
 
   if (!out.encapsulated) {
     if (out.bits_allocated != 8 && out.bits_allocated != 16) {
-      throw InputError(name + ": " + std::to_string(out.bits_allocated) +
+      throw DicomRefusal(name + ": " + std::to_string(out.bits_allocated) +
                        " bits allocated per sample (0028,0100); expected 8 or 16");
     }
     const bool grey = out.samples == 1 && (pi.empty() || pi == "MONOCHROME1" || pi == "MONOCHROME2");
     const bool colour = out.samples == 3 && (pi == "RGB" || pi == "YBR_FULL" || pi == "YBR_FULL_422");
     if (!grey && !colour) {
-      throw InputError(name + ": " + std::to_string(out.samples) + " sample(s) per pixel in photometric "
+      throw DicomRefusal(name + ": " + std::to_string(out.samples) + " sample(s) per pixel in photometric "
                        "interpretation '" + pi + "' (0028,0004); expected MONOCHROME1 or MONOCHROME2 (grey), or "
                        "RGB, YBR_FULL or YBR_FULL_422 (colour)");
     }
     // YBR_FULL_422: two pixels in four bytes (Y, Y, Cb, Cr).
     const bool ybr_422 = pi == "YBR_FULL_422";
     if (ybr_422 && (out.bits_allocated != 8 || out.columns % 2 != 0)) {
-      throw InputError(name + ": YBR_FULL_422 pixels of " + std::to_string(out.bits_allocated) + " bits in rows of " +
+      throw DicomRefusal(name + ": YBR_FULL_422 pixels of " + std::to_string(out.bits_allocated) + " bits in rows of " +
                        std::to_string(out.columns) + "; expected 8 bits and an even number of columns");
     }
     if (out.bits_stored > out.bits_allocated || out.high_bit >= out.bits_allocated ||
         (out.high_bit >= 0 && out.bits_stored > 0 && out.high_bit + 1 < out.bits_stored)) {
-      throw InputError(name + ": " + std::to_string(out.bits_stored) + " bits stored with high bit " +
+      throw DicomRefusal(name + ": " + std::to_string(out.bits_stored) + " bits stored with high bit " +
                        std::to_string(out.high_bit) + " (0028,0101-0102) in " + std::to_string(out.bits_allocated) +
                        " allocated; expected the stored bits within the allocated ones");
     }
-    if (pixels->length == kUndefined) r.fail(pixels->value_at, "native pixel data of a defined length");
+    if (pixels->length == kUndefined) r.fail_pixels(pixels->value_at, "native pixel data of a defined length");
     out.pixels_at = pixels->value_at;
     out.frame_size = std::uint64_t(out.rows) * std::uint64_t(out.columns) * std::uint64_t(ybr_422 ? 2 : out.samples) *
                      std::uint64_t(out.bits_allocated / 8);
@@ -557,32 +564,36 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
 
   // Encapsulated: a basic offset table item, then the fragments, then the
   // sequence's end.
-  if (pixels->length != kUndefined) r.fail(pixels->value_at, "encapsulated pixel data of undefined length");
+  if (pixels->length != kUndefined) r.fail_pixels(pixels->value_at, "encapsulated pixel data of undefined length");
   std::vector<std::uint64_t> offsets;
   bool first = true;
   std::string ended;
+  bool at_boundary = false;
   for (;;) {
     if (r.size() - r.at() < 8) {
+      // At a fragment's end: the fragments so far are whole (only the end
+      // mark may be missing).
+      at_boundary = true;
       ended = "its compressed pixel data ends before its end mark (FFFE,E0DD)";
       break;
     }
     const Header h = r.header(false);
     if (h.tag == kSequenceEnd) break;
     if (h.tag != kItem || h.length == kUndefined) {
-      r.fail(h.value_at - 8, "a fragment item (FFFE,E000) of defined length, or the pixel data's end (FFFE,E0DD)");
+      r.fail_pixels(h.value_at - 8, "a fragment item (FFFE,E000) of defined length, or the pixel data's end (FFFE,E0DD)");
     }
     if (h.length > r.size() - h.value_at) {
       ended = "its compressed pixel data ends within a fragment";
       break;
     }
     if (first) {
-      if (h.length / 4 > 1'000'000) r.fail(h.value_at, "a basic offset table of at most 10^6 entries");
+      if (h.length / 4 > 1'000'000) r.fail_pixels(h.value_at, "a basic offset table of at most 10^6 entries");
       for (std::uint32_t i = 0; i + 4 <= h.length; i += 4) offsets.push_back(r.u32());
       r.seek(h.value_at + h.length);
       first = false;
       continue;
     }
-    if (out.fragments.size() >= 10'000'000) r.fail(h.value_at, "at most 10^7 fragments");
+    if (out.fragments.size() >= 10'000'000) r.fail_pixels(h.value_at, "at most 10^7 fragments");
     out.fragments.emplace_back(h.value_at, h.length);
     r.seek(h.value_at + h.length);
   }
@@ -632,6 +643,12 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
                                    "offset table; expected a stream per frame",
                                    name, out.frames, out.fragments.size(), out.first_fragment.size()));
     }
+  }
+  if (!ended.empty() && at_boundary && out.first_fragment.size() == frames &&
+      (out.fragments.size() == frames || offsets.size() == frames || out.frames == 1)) {
+    // Every frame is there, each whole by the count or the table: only the
+    // end mark is missing.
+    ended.clear();
   }
   if (!ended.empty()) {
     // A file cut short: the frames whose fragments are all there (the last

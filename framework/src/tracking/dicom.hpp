@@ -11,7 +11,15 @@
 #include <utility>
 #include <vector>
 
+#include "gtrack/error.hpp"
+
 namespace gtrack::detail {
+
+// A file refused for what its header says (an encoding, a kind of pixel
+// not taken): final, however long a followed folder's writer is waited on.
+struct DicomRefusal : InputError {
+  using InputError::InputError;
+};
 
 struct DicomLayout {
   int rows = 0, columns = 0;

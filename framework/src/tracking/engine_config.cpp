@@ -147,7 +147,8 @@ SearchConfig read_search(const ConfigTable& t, const Sensor& sensor, const Senso
   // Default box: the field of view around the nominal position, grown by the
   // model's radius so that a gripper half out of view is still reachable.
   const ImageSize size = sensor.image_size();
-  const double half = 0.5 * std::max(size.width, size.height) * sensor.mm_per_pixel() + radius;
+  const Eigen::Vector2d pixel = pixel_size_mm(sensor);
+  const double half = 0.5 * std::max(size.width * pixel.x(), size.height * pixel.y()) + radius;
   const Eigen::Vector3d nominal = sensor.nominal_position_mm();
   SearchConfig s;
   s.position_min_mm = vec3(t, "position_min_mm", nominal.array() - half);

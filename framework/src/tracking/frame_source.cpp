@@ -486,7 +486,8 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
 // A folder's image named .dcm or .dicom, or without an extension (listed
 // only when it is DICOM): a single-frame DICOM file (one file per frame,
 // as scanners export), decoded as a DICOM file's frames are; what cannot
-// be read is said in `said` and gives no image.
+// be read (yet: a file still being written) is said in `said` and gives no
+// image, what is refused for its header throws.
 bool is_dicom_name(const fs::path& p) {
   const std::string ext = lowercase_extension(p);
   return ext == ".dcm" || ext == ".dicom" || ext.empty();  // a folder lists no other file without an extension
@@ -497,11 +498,13 @@ cv::Mat read_dicom_image(const fs::path& p, std::string& said) {
     if (!in) throw InputError(p.string() + ": cannot open the file");
     const detail::DicomLayout layout = detail::read_dicom_layout(in, p.string());
     if (layout.frames != 1) {
-      throw InputError(p.string() + ": a DICOM file of " + std::to_string(layout.frames) +
-                       " frames in a folder of images; give the file itself as --input");
+      throw detail::DicomRefusal(p.string() + ": a DICOM file of " + std::to_string(layout.frames) +
+                                 " frames in a folder of images; give the file itself as --input");
     }
     said.clear();
     return decode_dicom_frame(layout, in, 0, p.string());
+  } catch (const detail::DicomRefusal&) {
+    throw;  // final: a followed folder's writer is not waited on for it
   } catch (const InputError& e) {
     said = e.what();
     return cv::Mat();
@@ -601,7 +604,10 @@ class FolderSource final : public FrameSource {
   void scan() {
     static const std::vector<std::string> exts = {".png", ".jpg", ".jpeg", ".bmp", ".tif",
                                                   ".tiff", ".pgm", ".ppm", ".dcm", ".dicom"};
-    if (following() && unchanged_since_last_listing()) return;
+    // (A file that may yet turn out to be DICOM is looked at again even in
+    // a folder that did not change: it is being written in place.)
+    if (following() && !undecided_ && unchanged_since_last_listing()) return;
+    undecided_ = false;
     std::error_code ec;  // of the listing itself
     std::vector<fs::path> found;
     std::vector<std::string> seen;  // names to skip from the next listing on, if this one completes
@@ -621,12 +627,17 @@ class FolderSource final : public FrameSource {
         found.push_back(it->path());
       } else if (ext.empty()) {
         // A scanner's export names its DICOM files IM_0001, ... : "DICM"
-        // at byte 128 says what they are. One too short to say yet (being
-        // written) is looked at again.
+        // at byte 128 says what they are. Following, one that does not say
+        // so yet is looked at again until it has been unchanged for 2 s (a
+        // writer may set the size first and fill it in later).
         if (detail::is_dicom_file(it->path().string())) {
           found.push_back(it->path());
-        } else if (following() && fs::file_size(it->path(), entry_ec) < 132) {
-          seen.pop_back();
+        } else if (following()) {
+          const auto written = fs::last_write_time(it->path(), entry_ec);
+          if (entry_ec || fs::file_time_type::clock::now() - written < std::chrono::seconds(2)) {
+            seen.pop_back();
+            undecided_ = true;
+          }
         }
       }
     }
@@ -822,6 +833,7 @@ class FolderSource final : public FrameSource {
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
   bool warned_gap_ = false;
   std::unordered_set<std::string> known_;  // names listed so far
+  bool undecided_ = false;  // the last listing left a file without an extension that may yet be DICOM
   // See unchanged_since_last_listing().
   bool listed_ = false, mtime_trusted_ = false;
   fs::file_time_type listed_mtime_;
@@ -1083,8 +1095,9 @@ class DicomSource final : public FrameSource {
       : spec_(std::move(spec)), expected_(expected), filter_(range), in_(spec_, std::ios::binary) {
     if (!in_) throw InputError(spec_ + ": cannot open the file");
     layout_ = detail::read_dicom_layout(in_, spec_);
-    fps_ = layout_.fps > 0 ? layout_.fps : fallback_fps;
-    if (!layout_.cut_short.empty()) logger().warn("{}: {}", spec_, layout_.cut_short);
+    // The frames' times at the fallback rate when the file gives none; its
+    // fps() says 0 then, as a folder's does.
+    time_fps_ = layout_.fps > 0 ? layout_.fps : fallback_fps;
     index_ = std::max(0, range.first);
     logger().debug("{}: DICOM, {} frame(s) of {}x{}, {} sample(s) of {} bits, {}, {}, {} frames/s", spec_,
                    layout_.frames, layout_.columns, layout_.rows, layout_.samples, layout_.bits_allocated,
@@ -1092,18 +1105,20 @@ class DicomSource final : public FrameSource {
   }
 
   std::optional<Frame> next() override {
+    if (!warned_ && !quiet() && !layout_.cut_short.empty()) logger().warn("{}: {}", spec_, layout_.cut_short);
+    warned_ = true;
     while (index_ < layout_.frames && !filter_.done(index_) && !filter_.wanted(index_)) ++index_;
     if (index_ >= layout_.frames || filter_.done(index_)) return std::nullopt;
     Frame f;
     f.index = index_;
-    f.time_s = fps_ > 0 ? index_ / fps_ : 0.0;
+    f.time_s = time_fps_ > 0 ? index_ / time_fps_ : 0.0;
     f.name = spec_ + " frame " + std::to_string(index_);
     f.image = to_bgr(decode_dicom_frame(layout_, in_, index_, spec_), f.name);
     check_size(f.image, expected_, f.name);
     ++index_;
     return f;
   }
-  double fps() const override { return fps_; }
+  double fps() const override { return layout_.fps; }
   int frame_count() const override { return layout_.frames; }
   std::string ended_early() const override { return layout_.cut_short; }
   std::optional<std::pair<double, double>> pixel_size_mm() const override {
@@ -1121,8 +1136,9 @@ class DicomSource final : public FrameSource {
   RangeFilter filter_;
   std::ifstream in_;
   detail::DicomLayout layout_;
-  double fps_ = 0;
+  double time_fps_ = 30;
   int index_ = 0;
+  bool warned_ = false;  // of a file cut short, at the first frame
 };
 
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,

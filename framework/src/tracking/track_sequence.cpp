@@ -192,14 +192,15 @@ std::string another_clock(const StimulusLog& log, int frame, double time_s) {
 // camera), and every frame would take its first row's reading (a log that
 // ends early, or one keyed by frame, is warned about as each frame outside
 // it comes); a time_s log with a
-// folder of images or a TIFF stack, which have no frame rate of their own,
-// runs on the 30 frames/s taken for them unless [tracker] fps says
-// otherwise.
+// folder of images, a TIFF stack or a DICOM file that gives none, which
+// have no frame rate of their own, runs on the 30 frames/s taken for them
+// unless [tracker] fps says otherwise.
 void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options, const FrameRange& range,
-                             int expected, double fps, double config_fps) {
+                             int expected, double fps, double config_fps, double source_fps) {
   const bool by_time = log.key() == StimulusLog::Key::Time;
   std::error_code ec;
-  const bool images = fs::is_directory(options.input, ec) || detail::is_tiff_file(options.input);
+  const bool images = fs::is_directory(options.input, ec) || detail::is_tiff_file(options.input) ||
+                      (detail::is_dicom_file(options.input) && !(source_fps > 0));
   if (by_time && images && config_fps <= 0) {
     logger().warn("{}: the images carry no frame rate, so {:g} frames/s is taken for the time_s log {} and the "
                   "material's response; if the camera ran at another rate, set [tracker] fps",
@@ -592,16 +593,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                   config.tracker.fps, config.tracker.fps);
   }
   // A pixel size the input gives (a scanner's DICOM export) that is not the
-  // sensor's: positions would be scaled wrong. An affine projection (a
-  // slice) gives the sensor's width and height of a pixel; a camera's,
-  // mm_per_pixel for both.
+  // sensor's (pixel_size_mm): positions would be scaled wrong.
   if (const auto pixel = source->pixel_size_mm(); pixel && setup.sensor->mm_per_pixel() > 0) {
-    const Projection p = setup.sensor->projection();
-    const bool affine = p.world_to_image.row(2).head<3>().isZero() && p.world_to_image(2, 3) != 0;
-    const double w = affine ? std::abs(p.world_to_image(2, 3)) / p.world_to_image.row(0).head<3>().norm()
-                            : setup.sensor->mm_per_pixel();
-    const double h = affine ? std::abs(p.world_to_image(2, 3)) / p.world_to_image.row(1).head<3>().norm()
-                            : setup.sensor->mm_per_pixel();
+    const Eigen::Vector2d sensor_pixel = pixel_size_mm(*setup.sensor);
+    const double w = sensor_pixel.x(), h = sensor_pixel.y();
     const auto off = [](double file, double sensor) { return !(std::abs(file / sensor - 1) <= 0.02); };
     if (off(pixel->first, w) || off(pixel->second, h)) {
       logger().warn("{}: its pixels are {:.4g} x {:.4g} mm (width x height, as the file says), the sensor's {:.4g} x "
@@ -658,7 +653,8 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     const std::string plugin = setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "";
     check_log_unit(*log, *setup.stimulus, plugin);
   }
-  if (log && !options.follow_stimulus) check_log_covers_frames(*log, options, range, expected, fps, config.tracker.fps);
+  if (log && !options.follow_stimulus) check_log_covers_frames(*log, options, range, expected, fps, config.tracker.fps,
+                                                                  source->fps());
 
   // The reading of a frame: the log's, or its nearest past the log's ends.
   bool warned_range = false;
