@@ -246,7 +246,8 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   // An ultrasound slice does not show where within its slab the gripper
   // lies: off track is judged within the imaging plane; so it is for a
   // camera with --off-track-in-plane.
-  opt.off_track_in_plane = gtrack::cli::images_a_slab(*setup.sensor) || vm.count("off-track-in-plane") > 0;
+  const bool slab = gtrack::cli::images_a_slab(*setup.sensor);
+  opt.off_track_in_plane = slab || vm.count("off-track-in-plane") > 0;
   if (!(opt.out_of_view_below >= 0 && opt.out_of_view_below < 1)) {
     throw gtrack::cli::UsageError("--out-of-view-below must be a share in [0, 1)");
   }
@@ -329,9 +330,9 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   std::cout << "frames " << ev.frames << ": " << ev.in_view_frames << " in view (" << ev.evaluated_frames
             << " evaluated, " << ev.lost_in_view_frames << " lost, " << ev.off_track_frames
             << " off track: endpoints > " << opt.off_track_endpoint_um << " um "
-            << (gtrack::cli::images_a_slab(*setup.sensor) ? "in the imaging plane"
-                : opt.off_track_in_plane                  ? "across the viewing axis"
-                                                          : "in 3D")
+            << (slab                     ? "in the imaging plane"
+                : opt.off_track_in_plane ? "across the viewing axis"
+                                         : "in 3D")
             << "), "
             << ev.out_of_view_frames << " out of view; lost in all " << ev.lost_frames << " (missing "
             << ev.missing_frames << ")\n";
@@ -339,7 +340,6 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
     std::cout << "  no frame in view has an estimate: there are no error figures\n";
   } else {
     print_row("position 3D", ev.in_view.position_um, "um");
-    const bool slab = gtrack::cli::images_a_slab(*setup.sensor);
     print_row(slab ? "in the imaging plane" : "position in-plane", ev.in_view.position_inplane_um, "um");
     print_row(slab ? "across the plane" : "depth", ev.in_view.depth_um, "um");
     print_row("orientation", ev.in_view.orientation_deg, "deg");

@@ -298,14 +298,18 @@ std::string transfer_syntax_name(const std::string& uid) {
   return "transfer syntax " + uid;
 }
 
+bool has_dicom_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".dcm" || ext == ".dicom";
+}
+
 bool is_dicom_file(const std::string& spec) {
   std::error_code ec;
   if (!fs::is_regular_file(spec, ec)) return false;
   const fs::path p(spec);
   if (p.filename() == "DICOMDIR") return false;  // an index of other files
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext == ".dcm" || ext == ".dicom") return true;
+  if (has_dicom_extension(spec)) return true;
   std::ifstream in(spec, std::ios::binary);
   char magic[132] = {};
   return in.read(magic, sizeof magic) && std::string_view(magic + 128, 4) == "DICM";

@@ -55,6 +55,9 @@ struct DicomLayout {
 // expected, for anything it cannot take.
 DicomLayout read_dicom_layout(std::istream& in, const std::string& name);
 
+// Named .dcm or .dicom, in any case.
+bool has_dicom_extension(const std::string& path);
+
 // A regular file named .dcm or .dicom (any case), or with "DICM" at byte
 // 128, as scanners export without an extension (not DICOMDIR, an index).
 bool is_dicom_file(const std::string& spec);

@@ -489,8 +489,8 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
 // be read (yet: a file still being written) is said in `said` and gives no
 // image, what is refused for its header throws.
 bool is_dicom_name(const fs::path& p) {
-  const std::string ext = lowercase_extension(p);
-  return ext == ".dcm" || ext == ".dicom" || ext.empty();  // a folder lists no other file without an extension
+  // A folder lists no other file without an extension.
+  return detail::has_dicom_extension(p.string()) || p.extension().empty();
 }
 cv::Mat read_dicom_image(const fs::path& p, std::string& said) {
   try {
