@@ -1,5 +1,5 @@
-// DICOM input: a scanner's multi-frame file (native, JPEG or JPEG 2000
-// frames) read frame by frame, its frame rate taken, and what it cannot
+// DICOM input: a scanner's multi-frame file (native, JPEG, JPEG 2000 or
+// RLE frames) read frame by frame, its frame rate taken, and what it cannot
 // take refused in a line; a B-mode cine loop tracked as its frames are.
 #include <gtest/gtest.h>
 #include <gtrack/frame_source.hpp>
@@ -351,6 +351,87 @@ TEST(Dicom, CompressedFramesAreDecodedFrameByFrame) {
   }
 }
 
+// RLE lossless frames (PS3.5 annex G), grey, 16-bit and colour: the
+// frames written, as their native file gives them.
+TEST(Dicom, RleFramesAreTheImagesWritten) {
+  const fs::path dir = dir_for("rle");
+  DicomWriteOptions o;
+  o.transfer_syntax = "1.2.840.10008.1.2.5";
+  o.compress_as = ".rle";
+  // Grey, with runs (the square, a flat band) and noise.
+  auto grey = frames(3, CV_8UC1, 300, 30);
+  for (cv::Mat& f : grey) f.colRange(100, 290).setTo(77);
+  write_dicom(dir / "grey.dcm", grey, o);
+  auto got = read_all(dir / "grey.dcm", {300, 30});
+  ASSERT_EQ(got.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(got[i], bgr(grey[i]))) << "frame " << i;
+  // 12 bits stored in 16, and colour (planar or not in the header: RLE's
+  // segments are planes either way), each against its native file.
+  DicomWriteOptions twelve = o;
+  twelve.bits_stored = 12;
+  DicomWriteOptions colour = o;
+  colour.planar = 1;
+  for (const auto& [written, opt] : {std::pair{frames(2, CV_16UC1), twelve}, std::pair{frames(2, CV_8UC3), colour},
+                                     std::pair{frames(2, CV_8UC3), o}}) {
+    write_dicom(dir / "rle.dcm", written, opt);
+    DicomWriteOptions native = opt;
+    native.transfer_syntax = "1.2.840.10008.1.2.1";
+    native.compress_as.clear();
+    write_dicom(dir / "native.dcm", written, native);
+    got = read_all(dir / "rle.dcm", {40, 30});
+    const auto expected = read_all(dir / "native.dcm", {40, 30});
+    ASSERT_EQ(got.size(), 2u);
+    for (int i = 0; i < 2; ++i) EXPECT_TRUE(same(got[i], expected[i])) << "frame " << i;
+  }
+  EXPECT_GT(cv::norm(got[0], got[1], cv::NORM_INF), 0) << "frames unlike each other";
+  // The most significant bytes' segment first: 0xFF00 and 0x00FF, a
+  // frame made by hand (literal runs, padded with the no-op 0x80).
+  const std::string header = std::string("\x02\0\0\0\x40\0\0\0\x46\0\0\0", 12) + std::string(52, '\0');
+  DicomWriteOptions hand = o;
+  hand.encoded = {header + std::string("\x03\xFF\x00\xFF\x00\x80", 6) + std::string("\x03\x00\xFF\x00\xFF\x80", 6)};
+  write_dicom(dir / "hand.dcm", {cv::Mat(2, 2, CV_16UC1)}, hand);
+  got = read_all(dir / "hand.dcm", {2, 2});
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].at<cv::Vec3b>(0, 0), cv::Vec3b::all(254));
+  EXPECT_EQ(got[0].at<cv::Vec3b>(0, 1), cv::Vec3b::all(1));
+  // A replicate run (-3: the byte 4 times) fills a grey 2x2 frame.
+  hand.encoded = {std::string("\x01\0\0\0\x40\0\0\0", 8) + std::string(56, '\0') + std::string("\xFD\x2A", 2)};
+  write_dicom(dir / "run.dcm", {cv::Mat(2, 2, CV_8UC1)}, hand);
+  got = read_all(dir / "run.dcm", {2, 2});
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(cv::countNonZero(got[0].reshape(1) == 42), 12);
+  // A segment that ends short, and a header with the wrong segment count:
+  // one line naming the frame.
+  hand.encoded = {std::string("\x01\0\0\0\x40\0\0\0", 8) + std::string(56, '\0') + std::string("\xFE\x2A", 2)};
+  write_dicom(dir / "short.dcm", {cv::Mat(2, 2, CV_8UC1)}, hand);
+  std::string e = input_error(dir / "short.dcm", {2, 2});
+  EXPECT_NE(e.find("short.dcm frame 0: its RLE segment 1 decodes to 3 bytes; expected 4 (2x2 pixels)"),
+            std::string::npos)
+      << e;
+  write_dicom(dir / "count.dcm", {cv::Mat(30, 40, CV_8UC3, cv::Scalar::all(9))}, o);
+  std::string bytes;
+  {
+    std::ifstream in(dir / "count.dcm", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t at = bytes.find(std::string("\x03\0\0\0\x40\0\0\0", 8));
+  ASSERT_NE(at, std::string::npos);
+  bytes[at] = 1;
+  std::ofstream(dir / "count.dcm", std::ios::binary) << bytes;
+  e = input_error(dir / "count.dcm");
+  EXPECT_NE(e.find("count.dcm frame 0: its RLE header gives 1 segments; expected 3 (3 sample(s) of 8 bits)"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  // RLE keeps every sample: YBR_FULL_422 is no RLE frame.
+  DicomWriteOptions ybr = o;
+  ybr.photometric = "YBR_FULL_422";
+  write_dicom(dir / "ybr.dcm", frames(1, CV_8UC3), ybr);
+  e = input_error(dir / "ybr.dcm");
+  EXPECT_NE(e.find("ybr.dcm: RLE lossless frames in photometric interpretation YBR_FULL_422"), std::string::npos)
+      << e;
+}
+
 // What it cannot take is one line naming the file and what was expected.
 TEST(Dicom, AFileItCannotTakeIsRefusedInALine) {
   const fs::path dir = dir_for("refused");
@@ -395,11 +476,12 @@ TEST(Dicom, AFileItCannotTakeIsRefusedInALine) {
         << e;
   }
   // A transfer syntax it does not decode.
-  DicomWriteOptions rle;
-  rle.transfer_syntax = "1.2.840.10008.1.2.5";
-  write_dicom(dir / "rle.dcm", written, rle);
-  e = input_error(dir / "rle.dcm");
-  EXPECT_NE(e.find("rle.dcm: its pixels are stored as RLE lossless (1.2.840.10008.1.2.5); expected native pixels"),
+  DicomWriteOptions ls;
+  ls.transfer_syntax = "1.2.840.10008.1.2.4.80";
+  write_dicom(dir / "ls.dcm", written, ls);
+  e = input_error(dir / "ls.dcm");
+  EXPECT_NE(e.find("ls.dcm: its pixels are stored as JPEG-LS lossless (1.2.840.10008.1.2.4.80); expected native "
+                   "pixels"),
             std::string::npos)
       << e;
   // Another size than the sensor's, naming the frame.

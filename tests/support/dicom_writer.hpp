@@ -1,8 +1,9 @@
 // Writing DICOM files in tests, as a scanner exports them: a multi-frame
 // file with native pixels (explicit or implicit VR) or with each frame
-// compressed (JPEG, JPEG 2000), from OpenCV images.
+// compressed (JPEG, JPEG 2000, RLE lossless), from OpenCV images.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -25,7 +26,8 @@ struct DicomWriteOptions {
   int planar = 0;                // colour, native: 1 = one plane after another
   double frame_time_ms = 0;      // (0018,1063), 0: none
   std::string frame_time_vector;  // (0018,1065), "": none
-  std::string compress_as;       // ".jpg" or ".jp2": each frame encoded so (transfer syntax to match)
+  std::string compress_as;       // ".jpg", ".jp2" or ".rle": each frame encoded so (transfer syntax to match)
+  std::vector<std::string> encoded;  // compressed: these streams as the frames' (the frames give the header)
   int fragments_per_frame = 1;   // compressed: each frame's stream split into this many fragments
   bool offset_table = false;     // compressed: a basic offset table with each frame's offset
   bool strip_jfif = false;       // ".jpg": the JFIF marker taken out, as some scanners write theirs
@@ -76,6 +78,79 @@ class DicomWriter {
   bool explicit_;
   std::string out_;
 };
+
+// PackBits (PS3.5 G.3.1), a row at a time: runs of 3 to 128 equal bytes
+// replicated, the rest given as they are, 128 bytes at most a run.
+inline std::string packbits(const std::vector<unsigned char>& bytes, std::size_t row) {
+  std::string out;
+  for (std::size_t start = 0; start < bytes.size(); start += row) {
+    const std::size_t end = std::min(bytes.size(), start + row);
+    std::size_t i = start;
+    std::string literal;
+    const auto flush = [&] {
+      if (literal.empty()) return;
+      out += char(literal.size() - 1);
+      out += literal;
+      literal.clear();
+    };
+    while (i < end) {
+      std::size_t run = 1;
+      while (i + run < end && run < 128 && bytes[i + run] == bytes[i]) ++run;
+      if (run >= 3) {
+        flush();
+        out += char(static_cast<signed char>(1 - static_cast<int>(run)));
+        out += char(bytes[i]);
+        i += run;
+      } else {
+        literal += char(bytes[i++]);
+        if (literal.size() == 128) flush();
+      }
+    }
+    flush();
+  }
+  return out;
+}
+
+// A frame as RLE lossless (PS3.5 annex G): the header, then a segment per
+// byte of each sample, the most significant first.
+inline std::string rle_frame(const cv::Mat& frame) {
+  cv::Mat m;
+  if (frame.channels() == 3) {
+    cv::cvtColor(frame, m, cv::COLOR_BGR2RGB);
+  } else {
+    m = frame;
+  }
+  std::vector<cv::Mat> samples;
+  cv::split(m, samples);
+  const int bytes_per_sample = static_cast<int>(m.elemSize1());
+  std::vector<std::string> segments;
+  for (const cv::Mat& c : samples) {
+    for (int b = bytes_per_sample - 1; b >= 0; --b) {
+      std::vector<unsigned char> lane;
+      for (int y = 0; y < c.rows; ++y) {
+        for (int x = 0; x < c.cols; ++x) {
+          const unsigned v = c.depth() == CV_16U ? c.at<std::uint16_t>(y, x) : c.at<std::uint8_t>(y, x);
+          lane.push_back(static_cast<unsigned char>((v >> (8 * b)) & 0xFF));
+        }
+      }
+      std::string seg = packbits(lane, static_cast<std::size_t>(c.cols));
+      if (seg.size() % 2) seg += '\x80';  // a no-op as padding
+      segments.push_back(seg);
+    }
+  }
+  std::string header;
+  const auto u32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) header += char((v >> (8 * i)) & 0xFF);
+  };
+  u32(static_cast<std::uint32_t>(segments.size()));
+  std::uint32_t at = 64;
+  for (std::size_t i = 0; i < 15; ++i) {
+    u32(i < segments.size() ? at : 0);
+    if (i < segments.size()) at += static_cast<std::uint32_t>(segments[i].size());
+  }
+  for (const std::string& seg : segments) header += seg;
+  return header;
+}
 
 // Writes `frames` (all of one size and type: 8 or 16 bits, grey or BGR).
 inline void write_dicom(const std::filesystem::path& file, const std::vector<cv::Mat>& frames,
@@ -167,9 +242,17 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
     d.raw(pixels);
   } else {
     std::vector<std::vector<std::string>> parts;
-    for (const cv::Mat& f : frames) {
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      const cv::Mat& f = frames[k];
       std::vector<unsigned char> encoded;
-      cv::imencode(o.compress_as, f, encoded);
+      if (k < o.encoded.size()) {
+        encoded.assign(o.encoded[k].begin(), o.encoded[k].end());
+      } else if (o.compress_as == ".rle") {
+        const std::string rle = rle_frame(f);
+        encoded.assign(rle.begin(), rle.end());
+      } else {
+        cv::imencode(o.compress_as, f, encoded);
+      }
       if (o.strip_jfif && encoded.size() > 6 && encoded[2] == 0xFF && encoded[3] == 0xE0) {
         const std::size_t app0 = 2 + 2 + ((std::size_t(encoded[4]) << 8) | encoded[5]);
         encoded.erase(encoded.begin() + 2, encoded.begin() + static_cast<std::ptrdiff_t>(app0));

@@ -40,6 +40,7 @@ constexpr std::uint32_t kPixelData = tag(0x7FE0, 0x0010);
 
 const char* const kExplicitLittle = "1.2.840.10008.1.2.1";
 const char* const kImplicitLittle = "1.2.840.10008.1.2";
+const char* const kRleLossless = "1.2.840.10008.1.2.5";
 
 struct Header {
   std::uint32_t tag = 0;
@@ -325,6 +326,77 @@ std::vector<std::pair<std::uint64_t, std::uint64_t>> DicomLayout::frame_spans(in
   return {fragments.begin() + static_cast<std::ptrdiff_t>(a), fragments.begin() + static_cast<std::ptrdiff_t>(b)};
 }
 
+std::vector<unsigned char> decode_rle_frame(const std::vector<unsigned char>& data, const DicomLayout& layout,
+                                            const std::string& what) {
+  // PS3.5 annex G: a 64-byte header (the segment count, then 15 offsets
+  // from the frame's start), then each segment, a PackBits stream of one
+  // byte of one sample for every pixel: the most significant byte first,
+  // sample after sample.
+  const auto u32 = [&](std::size_t at) {
+    return std::uint32_t(data[at]) | (std::uint32_t(data[at + 1]) << 8) | (std::uint32_t(data[at + 2]) << 16) |
+           (std::uint32_t(data[at + 3]) << 24);
+  };
+  const int bytes_per_sample = layout.bits_allocated / 8;
+  const std::uint32_t segments = static_cast<std::uint32_t>(layout.samples * bytes_per_sample);
+  if (data.size() < 64) {
+    throw InputError(fmt::format("{}: its RLE data holds {} bytes; expected a 64-byte header and its segments", what,
+                                 data.size()));
+  }
+  if (u32(0) != segments) {
+    throw InputError(fmt::format("{}: its RLE header gives {} segments; expected {} ({} sample(s) of {} bits)", what,
+                                 u32(0), segments, layout.samples, layout.bits_allocated));
+  }
+  const std::uint64_t pixels = std::uint64_t(layout.rows) * std::uint64_t(layout.columns);
+  // A run of 128 bytes takes 2: no frame decodes to more than 64 times its
+  // size (checked before the frame is made).
+  if (pixels * segments > 64 * std::uint64_t(data.size())) {
+    throw InputError(fmt::format("{}: its RLE data holds {} bytes, which decode to at most {}; expected {} ({}x{} "
+                                 "pixels, {} segment(s))",
+                                 what, data.size(), 64 * std::uint64_t(data.size()), pixels * segments,
+                                 layout.columns, layout.rows, segments));
+  }
+  std::vector<unsigned char> out(pixels * segments);
+  for (std::uint32_t s = 0; s < segments; ++s) {
+    const std::uint64_t begin = u32(4 + 4 * s);
+    const std::uint64_t end = s + 1 < segments ? u32(8 + 4 * s) : data.size();
+    if (begin < 64 || end < begin || end > data.size()) {
+      throw InputError(fmt::format("{}: its RLE segment {} runs from byte {} to {} of {}; expected it after the "
+                                   "64-byte header, before the next segment, within the data",
+                                   what, s + 1, begin, end, data.size()));
+    }
+    // Sample c's byte b (0: the most significant) of each pixel; native
+    // order is little endian, each sample's plane after the other.
+    const std::uint32_t c = s / static_cast<std::uint32_t>(bytes_per_sample);
+    const std::uint32_t b = s % static_cast<std::uint32_t>(bytes_per_sample);
+    unsigned char* plane = out.data() + c * pixels * static_cast<std::uint64_t>(bytes_per_sample);
+    const std::uint64_t step = static_cast<std::uint64_t>(bytes_per_sample);
+    const std::uint64_t lane = static_cast<std::uint64_t>(bytes_per_sample) - 1 - b;
+    std::uint64_t n = 0;  // pixels decoded
+    std::uint64_t at = begin;
+    while (n < pixels && at < end) {
+      const int control = static_cast<signed char>(data[at++]);
+      if (control >= 0) {
+        // control + 1 bytes as they are.
+        const std::uint64_t count = std::min<std::uint64_t>({std::uint64_t(control) + 1, end - at, pixels - n});
+        for (std::uint64_t i = 0; i < count; ++i) plane[(n + i) * step + lane] = data[at + i];
+        n += count;
+        at += std::uint64_t(control) + 1;
+      } else if (control != -128 && at < end) {
+        // The next byte, 1 - control times.
+        const std::uint64_t count = std::min<std::uint64_t>(std::uint64_t(1 - control), pixels - n);
+        for (std::uint64_t i = 0; i < count; ++i) plane[(n + i) * step + lane] = data[at];
+        n += count;
+        ++at;
+      }
+    }
+    if (n < pixels) {
+      throw InputError(fmt::format("{}: its RLE segment {} decodes to {} bytes; expected {} ({}x{} pixels)", what,
+                                   s + 1, n, pixels, layout.columns, layout.rows));
+    }
+  }
+  return out;
+}
+
 std::vector<unsigned char> jpeg_marked_rgb(std::vector<unsigned char> stream) {
   if (stream.size() < 4 || stream[0] != 0xFF || stream[1] != 0xD8) return stream;
   // The markers up to the frame header: JFIF (APP0) or Adobe (APP14) say
@@ -398,19 +470,21 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   const std::string& ts = out.transfer_syntax;
   const bool explicit_vr = ts != kImplicitLittle;
   const bool native = ts == kImplicitLittle || ts == kExplicitLittle;
-  static const std::array<const char*, 4> kCompressed = {"1.2.840.10008.1.2.4.50", "1.2.840.10008.1.2.4.51",
-                                                         "1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91"};
+  static const std::array<const char*, 5> kCompressed = {"1.2.840.10008.1.2.4.50", "1.2.840.10008.1.2.4.51",
+                                                         "1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91",
+                                                         kRleLossless};
   if (!native && std::find(kCompressed.begin(), kCompressed.end(), ts) == kCompressed.end()) {
     const bool video = ts.rfind("1.2.840.10008.1.2.4.10", 0) == 0;
     throw DicomRefusal(name + ": its pixels are stored as " + transfer_syntax_name(ts) +
-                     "; expected native pixels (explicit or implicit VR little endian), JPEG (baseline or extended) "
-                     "or JPEG 2000 (" +
+                     "; expected native pixels (explicit or implicit VR little endian), JPEG (baseline or extended), "
+                     "JPEG 2000 or RLE lossless (" +
                      (video ? "the pixel data is a video stream: extract it, e.g. with gdcmraw -t 7fe0,0010, and give "
                               "the video as --input"
                             : "convert it, e.g. gdcmconv --raw in.dcm out.dcm") +
                      ")");
   }
   out.encapsulated = !native;
+  out.rle = ts == kRleLossless;
   r.transfer_syntax = ts;
 
   double frame_time_ms = 0, cine_rate = 0, display_rate = 0;
@@ -528,7 +602,8 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
     out.frames = whole;
   };
 
-  if (!out.encapsulated) {
+  if (!out.encapsulated || out.rle) {
+    // Native or RLE: samples the decoder lays out itself, checked here.
     if (out.bits_allocated != 8 && out.bits_allocated != 16) {
       throw DicomRefusal(name + ": " + std::to_string(out.bits_allocated) +
                        " bits allocated per sample (0028,0100); expected 8 or 16");
@@ -540,8 +615,13 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
                        "interpretation '" + pi + "' (0028,0004); expected MONOCHROME1 or MONOCHROME2 (grey), or "
                        "RGB, YBR_FULL or YBR_FULL_422 (colour)");
     }
-    // YBR_FULL_422: two pixels in four bytes (Y, Y, Cb, Cr).
+    // YBR_FULL_422: two pixels in four bytes (Y, Y, Cb, Cr); RLE keeps every
+    // pixel's three samples (PS3.5 8.2.2), so it has no such frames.
     const bool ybr_422 = pi == "YBR_FULL_422";
+    if (ybr_422 && out.rle) {
+      throw DicomRefusal(name + ": RLE lossless frames in photometric interpretation YBR_FULL_422 (0028,0004); "
+                                "expected MONOCHROME1, MONOCHROME2, RGB or YBR_FULL, as RLE keeps every sample");
+    }
     if (ybr_422 && (out.bits_allocated != 8 || out.columns % 2 != 0)) {
       throw DicomRefusal(name + ": YBR_FULL_422 pixels of " + std::to_string(out.bits_allocated) + " bits in rows of " +
                        std::to_string(out.columns) + "; expected 8 bits and an even number of columns");
@@ -552,10 +632,12 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
                        std::to_string(out.high_bit) + " (0028,0101-0102) in " + std::to_string(out.bits_allocated) +
                        " allocated; expected the stored bits within the allocated ones");
     }
-    if (pixels->length == kUndefined) r.fail_pixels(pixels->value_at, "native pixel data of a defined length");
-    out.pixels_at = pixels->value_at;
     out.frame_size = std::uint64_t(out.rows) * std::uint64_t(out.columns) * std::uint64_t(ybr_422 ? 2 : out.samples) *
                      std::uint64_t(out.bits_allocated / 8);
+  }
+  if (!out.encapsulated) {
+    if (pixels->length == kUndefined) r.fail_pixels(pixels->value_at, "native pixel data of a defined length");
+    out.pixels_at = pixels->value_at;
     const std::uint64_t needed = out.frame_size * std::uint64_t(out.frames);
     const std::uint64_t held = std::min<std::uint64_t>(pixels->length, r.size() - pixels->value_at);
     if (held < needed) {
@@ -638,7 +720,10 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
       const auto starts_with = [&](const unsigned char* sig, std::size_t len) {
         return n >= len && std::equal(sig, sig + len, head);
       };
-      if (f == 0 || starts_with(kJpeg, 3) || starts_with(kJ2k, 4) || starts_with(kJp2, 8)) {
+      // RLE: its header's segment count (1 to 15) and first offset (64).
+      const bool rle_header = out.rle && n == 8 && head[0] >= 1 && head[0] <= 15 && head[1] == 0 && head[2] == 0 &&
+                              head[3] == 0 && head[4] == 64 && head[5] == 0 && head[6] == 0 && head[7] == 0;
+      if (f == 0 || starts_with(kJpeg, 3) || starts_with(kJ2k, 4) || starts_with(kJp2, 8) || rle_header) {
         out.first_fragment.push_back(f);
       }
     }

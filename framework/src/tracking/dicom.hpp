@@ -2,7 +2,8 @@
 // lie, read without decoding them (and without a DICOM library: OpenCV's
 // reads single frames only). A B-mode cine loop exported by a scanner is
 // one multi-frame file: native pixels (8 or 16 bits, grey or colour), or
-// each frame compressed as JPEG or JPEG 2000 (decoded by OpenCV).
+// each frame compressed as JPEG or JPEG 2000 (decoded by OpenCV) or RLE
+// lossless (decoded here).
 #pragma once
 
 #include <cstdint>
@@ -31,7 +32,8 @@ struct DicomLayout {
   int frames = 1;
   std::string photometric;      // MONOCHROME2, RGB, YBR_FULL_422, ...
   std::string transfer_syntax;  // its UID
-  bool encapsulated = false;    // compressed: each frame's fragments are a JPEG or JPEG 2000 stream
+  bool encapsulated = false;    // compressed: each frame's fragments are a JPEG, JPEG 2000 or RLE stream
+  bool rle = false;             // RLE lossless: decoded by decode_rle_frame()
   double fps = 0;               // from the frame time (vector) or the cine rate; 0 when the file gives none
   // The first 2D ultrasound region's pixel size (0018,6011: PhysicalDeltaX
   // and Y in cm), in mm; 0 when the file gives none.
@@ -39,7 +41,8 @@ struct DicomLayout {
   // Why the file holds fewer whole frames than it says (cut short), or "".
   std::string cut_short;
 
-  // Native pixels: where the first frame starts and each frame's size.
+  // Native pixels: where the first frame starts and each frame's size (for
+  // RLE too: the size of a decoded frame).
   std::uint64_t pixels_at = 0, frame_size = 0;
   // Encapsulated: the fragments (offset in the file, length), and each
   // frame's first fragment (frame k has fragments [first[k], first[k+1])).
@@ -64,6 +67,13 @@ bool is_dicom_file(const std::string& spec);
 
 // The transfer syntax by name, for messages ("JPEG baseline (1.2.840...)").
 std::string transfer_syntax_name(const std::string& uid);
+
+// An RLE lossless frame (its fragments' bytes, in order) decoded to native
+// pixel bytes: 16-bit samples little endian, and 3 samples one plane after
+// the other (as PlanarConfiguration 1 lays them out). InputError naming
+// `what` when the frame does not hold the layout's pixels.
+std::vector<unsigned char> decode_rle_frame(const std::vector<unsigned char>& data, const DicomLayout& layout,
+                                            const std::string& what);
 
 // A JPEG stream of RGB samples (no JFIF or Adobe marker, component ids not
 // 'R', 'G', 'B') that a decoder would take as YCbCr: given an Adobe marker

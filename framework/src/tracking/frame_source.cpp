@@ -406,7 +406,8 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
   }
   const std::string& pi = layout.photometric;
   cv::Mat image;
-  if (layout.encapsulated) {
+  if (layout.rle) bytes = detail::decode_rle_frame(bytes, layout, what);  // native bytes, planes one after another
+  if (layout.encapsulated && !layout.rle) {
     // A JPEG of RGB samples that says so only in the DICOM header.
     const bool jpeg = layout.transfer_syntax == "1.2.840.10008.1.2.4.50" ||
                       layout.transfer_syntax == "1.2.840.10008.1.2.4.51";
@@ -441,7 +442,7 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
     } else {
       if (layout.samples == 1) {
         image = cv::Mat(layout.rows, layout.columns, CV_MAKETYPE(depth, 1), bytes.data()).clone();
-      } else if (layout.planar == 1) {
+      } else if (layout.planar == 1 || layout.rle) {
         const std::size_t plane = bytes.size() / 3;
         std::vector<cv::Mat> planes;
         for (int c = 0; c < 3; ++c) {
