@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 #include <string>
 #include <thread>
 #include <vector>
@@ -432,6 +433,87 @@ TEST(Dicom, RleFramesAreTheImagesWritten) {
       << e;
 }
 
+// A cine loop stored as a video stream (MPEG-2, H.264): its frames, in
+// order and at the file's rate, decoded by the video reader; a folder of
+// images refuses it, a stream that does not decode is one line.
+TEST(Dicom, AVideoStreamIsReadAsItsFrames) {
+  const fs::path dir = dir_for("video");
+  // A smooth picture with a square that moves: frames a lossy codec keeps
+  // apart.
+  std::vector<cv::Mat> written;
+  for (int i = 0; i < 12; ++i) {
+    cv::Mat m(96, 128, CV_8UC3);
+    for (int y = 0; y < m.rows; ++y) m.row(y).setTo(cv::Scalar(40 + y, 60, 200 - y));
+    cv::rectangle(m, cv::Rect(8 + 8 * i, 30, 24, 24), cv::Scalar::all(240), cv::FILLED);
+    written.push_back(m);
+  }
+  struct Kind {
+    const char* syntax;
+    const char* file;
+    int fourcc;
+  };
+  for (const Kind& k : {Kind{"1.2.840.10008.1.2.4.100", "stream.mpg", cv::VideoWriter::fourcc('M', 'P', 'G', '2')},
+                        Kind{"1.2.840.10008.1.2.4.102", "stream.ts", cv::VideoWriter::fourcc('H', '2', '6', '4')}}) {
+    SCOPED_TRACE(k.syntax);
+    {
+      cv::VideoWriter w((dir / k.file).string(), cv::CAP_FFMPEG, k.fourcc, 25, {128, 96});
+      ASSERT_TRUE(w.isOpened()) << "this machine's video writer takes " << k.file;
+      for (const cv::Mat& m : written) w << m;
+    }
+    std::ifstream in(dir / k.file, std::ios::binary);
+    DicomWriteOptions o;
+    o.transfer_syntax = k.syntax;
+    o.video.assign(std::istreambuf_iterator<char>(in), {});
+    o.fragments_per_frame = 3;
+    o.frame_time_ms = 50;
+    o.photometric = "YBR_PARTIAL_420";
+    write_dicom(dir / "video.dcm", written, o);
+    double fps = 0;
+    std::string what;
+    auto src = gtrack::open_frame_source((dir / "video.dcm").string(), {128, 96}, {}, 30);
+    EXPECT_DOUBLE_EQ(src->fps(), 20) << "the file's frame time, not the stream's rate";
+    EXPECT_EQ(src->frame_count(), 12);
+    std::vector<cv::Mat> got;
+    while (auto f = src->next()) {
+      EXPECT_EQ(f->name, (dir / "video.dcm").string() + " frame " + std::to_string(f->index));
+      EXPECT_DOUBLE_EQ(f->time_s, f->index / 20.0);
+      got.push_back(f->image);
+    }
+    ASSERT_EQ(got.size(), written.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      const double here = cv::norm(got[i], written[i], cv::NORM_L1) / static_cast<double>(got[i].total() * 3);
+      EXPECT_LE(here, 6.0) << "frame " << i;
+      const std::size_t other = i + 1 < got.size() ? i + 1 : i - 1;
+      EXPECT_LT(here, cv::norm(got[i], written[other], cv::NORM_L1) / static_cast<double>(got[i].total() * 3))
+          << "frame " << i << " is the frame written there, not its neighbour";
+    }
+    EXPECT_EQ(src->ended_early(), "");
+    src.reset();
+    // The stream's file in the temporary folder is gone with the source.
+    for (const auto& e : fs::directory_iterator(fs::temp_directory_path())) {
+      EXPECT_EQ(e.path().filename().string().rfind("gtrack_dicom_video_", 0), std::string::npos) << e.path();
+    }
+  }
+  // In a folder of images: refused, pointing to --input.
+  const fs::path folder = dir / "folder";
+  fs::create_directories(folder);
+  fs::copy_file(dir / "video.dcm", folder / "IM_0001");
+  std::string e = input_error(folder, {128, 96});
+  EXPECT_NE(e.find("IM_0001: a DICOM file of 12 frames as a video stream in a folder of images; give the file "
+                   "itself as --input"),
+            std::string::npos)
+      << e;
+  // A stream that is no video: one line naming the file.
+  DicomWriteOptions junk;
+  junk.transfer_syntax = "1.2.840.10008.1.2.4.102";
+  junk.video = std::string(4000, 'x');
+  write_dicom(dir / "junk.dcm", written, junk);
+  e = input_error(dir / "junk.dcm", {128, 96});
+  EXPECT_EQ(e.rfind((dir / "junk.dcm").string() + ": ", 0), 0u) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  EXPECT_EQ(e.find("gtrack_dicom_video_"), std::string::npos) << "names the file given, not its stream's copy: " << e;
+}
+
 // What it cannot take is one line naming the file and what was expected.
 TEST(Dicom, AFileItCannotTakeIsRefusedInALine) {
   const fs::path dir = dir_for("refused");
@@ -465,13 +547,14 @@ TEST(Dicom, AFileItCannotTakeIsRefusedInALine) {
   write_dicom(dir / "palette.dcm", written, palette);
   e = input_error(dir / "palette.dcm");
   EXPECT_NE(e.find("palette.dcm: palette colour pixels"), std::string::npos) << e;
-  for (const char* syntax : {"1.2.840.10008.1.2.4.70", "1.2.840.10008.1.2.4.102"}) {
+  for (const char* syntax : {"1.2.840.10008.1.2.4.70", "1.2.840.10008.1.2.4.201"}) {
     DicomWriteOptions other;
     other.transfer_syntax = syntax;
     write_dicom(dir / "other.dcm", written, other);
     e = input_error(dir / "other.dcm");
     EXPECT_NE(e.find("its pixels are stored as "), std::string::npos) << e;
-    EXPECT_NE(e.find(std::string(syntax) == "1.2.840.10008.1.2.4.102" ? "MPEG-4 AVC/H.264 video" : "JPEG lossless"),
+    EXPECT_NE(e.find(std::string(syntax) == "1.2.840.10008.1.2.4.201" ? "high-throughput JPEG 2000 lossless"
+                                                                       : "JPEG lossless"),
               std::string::npos)
         << e;
   }

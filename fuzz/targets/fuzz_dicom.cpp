@@ -24,7 +24,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   if (layout.rows <= 0 || layout.columns <= 0 || (layout.samples != 1 && layout.samples != 3)) __builtin_trap();
   if (layout.frames < 1) __builtin_trap();
-  for (int k = 0; k < layout.frames; ++k) {
+  // A video's stream is frame 0's spans.
+  for (int k = 0; k < (layout.video ? 1 : layout.frames); ++k) {
     const auto spans = layout.frame_spans(k);
     if (spans.empty()) __builtin_trap();
     for (const auto& [offset, length] : spans) {

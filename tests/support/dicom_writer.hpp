@@ -28,6 +28,8 @@ struct DicomWriteOptions {
   std::string frame_time_vector;  // (0018,1065), "": none
   std::string compress_as;       // ".jpg", ".jp2" or ".rle": each frame encoded so (transfer syntax to match)
   std::vector<std::string> encoded;  // compressed: these streams as the frames' (the frames give the header)
+  std::string video;             // a video stream as the pixel data, in fragments_per_frame fragments (the
+                                 // frames give the header; transfer syntax to match)
   int fragments_per_frame = 1;   // compressed: each frame's stream split into this many fragments
   bool offset_table = false;     // compressed: a basic offset table with each frame's offset
   bool strip_jfif = false;       // ".jpg": the JFIF marker taken out, as some scanners write theirs
@@ -208,7 +210,7 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
   d.us(0x0028, 0x0102,
        static_cast<std::uint16_t>(o.high_bit >= 0 ? o.high_bit : (o.bits_stored > 0 ? o.bits_stored : bits) - 1));
   d.us(0x0028, 0x0103, 0);
-  if (o.compress_as.empty()) {
+  if (o.compress_as.empty() && o.video.empty() && o.encoded.empty()) {
     std::string pixels;
     for (const cv::Mat& f : frames) {
       if (colour && o.photometric == "YBR_FULL_422") {
@@ -242,7 +244,15 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
     d.raw(pixels);
   } else {
     std::vector<std::vector<std::string>> parts;
-    for (std::size_t k = 0; k < frames.size(); ++k) {
+    if (!o.video.empty()) {
+      std::string s = o.video;
+      if (s.size() % 2) s += '\0';
+      std::vector<std::string> pieces;
+      const std::size_t step = (s.size() / o.fragments_per_frame + 1) & ~std::size_t(1);
+      for (std::size_t at = 0; at < s.size(); at += step) pieces.push_back(s.substr(at, step));
+      parts.push_back(pieces);
+    }
+    for (std::size_t k = 0; k < frames.size() && o.video.empty(); ++k) {
       const cv::Mat& f = frames[k];
       std::vector<unsigned char> encoded;
       if (k < o.encoded.size()) {

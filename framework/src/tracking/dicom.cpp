@@ -295,6 +295,11 @@ std::string transfer_syntax_name(const std::string& uid) {
   }};
   for (const auto& [u, n] : kNames) {
     if (uid == u) return std::string(n) + " (" + uid + ")";
+    // A video's fragmentable form.
+    if (uid.size() == std::strlen(u) + 2 && uid.rfind(u, 0) == 0 && uid.compare(uid.size() - 2, 2, ".1") == 0 &&
+        std::strstr(n, "video")) {
+      return "fragmentable " + std::string(n) + " (" + uid + ")";
+    }
   }
   return "transfer syntax " + uid;
 }
@@ -319,6 +324,7 @@ bool is_dicom_file(const std::string& spec) {
 std::vector<std::pair<std::uint64_t, std::uint64_t>> DicomLayout::frame_spans(int k) const {
   if (k < 0 || k >= frames) return {};
   if (!encapsulated) return {{pixels_at + frame_size * static_cast<std::uint64_t>(k), frame_size}};
+  if (video) return k == 0 ? fragments : decltype(fragments){};
   const std::size_t a = first_fragment.at(static_cast<std::size_t>(k));
   const std::size_t b =
       static_cast<std::size_t>(k) + 1 < first_fragment.size() ? first_fragment[static_cast<std::size_t>(k) + 1]
@@ -473,18 +479,27 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   static const std::array<const char*, 5> kCompressed = {"1.2.840.10008.1.2.4.50", "1.2.840.10008.1.2.4.51",
                                                          "1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91",
                                                          kRleLossless};
-  if (!native && std::find(kCompressed.begin(), kCompressed.end(), ts) == kCompressed.end()) {
-    const bool video = ts.rfind("1.2.840.10008.1.2.4.10", 0) == 0;
+  // MPEG-2, H.264 and HEVC (1.2.840.10008.1.2.4.100 to .108): the pixel
+  // data is one video stream, handed to the video decoder whole.
+  static const std::array<const char*, 9> kVideo = {
+      "1.2.840.10008.1.2.4.100", "1.2.840.10008.1.2.4.101", "1.2.840.10008.1.2.4.102",
+      "1.2.840.10008.1.2.4.103", "1.2.840.10008.1.2.4.104", "1.2.840.10008.1.2.4.105",
+      "1.2.840.10008.1.2.4.106", "1.2.840.10008.1.2.4.107", "1.2.840.10008.1.2.4.108"};
+  // Their fragmentable forms end in ".1" (1.2.840.10008.1.2.4.100.1, ...).
+  const std::string unfragmented = ts.size() > 2 && ts.compare(ts.size() - 2, 2, ".1") == 0 &&
+                                           ts.rfind("1.2.840.10008.1.2.4.10", 0) == 0
+                                       ? ts.substr(0, ts.size() - 2)
+                                       : ts;
+  const bool video = std::find(kVideo.begin(), kVideo.end(), unfragmented) != kVideo.end();
+  if (!native && !video && std::find(kCompressed.begin(), kCompressed.end(), ts) == kCompressed.end()) {
     throw DicomRefusal(name + ": its pixels are stored as " + transfer_syntax_name(ts) +
                      "; expected native pixels (explicit or implicit VR little endian), JPEG (baseline or extended), "
-                     "JPEG 2000 or RLE lossless (" +
-                     (video ? "the pixel data is a video stream: extract it, e.g. with gdcmraw -t 7fe0,0010, and give "
-                              "the video as --input"
-                            : "convert it, e.g. gdcmconv --raw in.dcm out.dcm") +
-                     ")");
+                     "JPEG 2000, RLE lossless, MPEG-2, H.264 or HEVC (convert it, e.g. gdcmconv --raw in.dcm "
+                     "out.dcm)");
   }
   out.encapsulated = !native;
   out.rle = ts == kRleLossless;
+  out.video = video;
   r.transfer_syntax = ts;
 
   double frame_time_ms = 0, cine_rate = 0, display_rate = 0;
@@ -685,6 +700,13 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   }
   if (offsets.empty()) offsets = extended_offsets;
   if (out.fragments.empty()) throw InputError(name + ": its compressed pixel data holds no fragment; expected a frame");
+  if (out.video) {
+    // One stream in every fragment, whatever the frames: the decoder finds
+    // them, and says where a stream cut short ends.
+    out.first_fragment = {0};
+    if (!ended.empty()) out.cut_short = ended + "; the frames of its video stream up to there are read";
+    return out;
+  }
   const std::size_t frames = static_cast<std::size_t>(out.frames);
   if (out.frames == 1) {
     out.first_fragment = {0};

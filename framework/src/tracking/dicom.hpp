@@ -3,7 +3,8 @@
 // reads single frames only). A B-mode cine loop exported by a scanner is
 // one multi-frame file: native pixels (8 or 16 bits, grey or colour), or
 // each frame compressed as JPEG or JPEG 2000 (decoded by OpenCV) or RLE
-// lossless (decoded here).
+// lossless (decoded here), or the whole loop as one MPEG-2, H.264 or HEVC
+// video stream (decoded by OpenCV's video reader).
 #pragma once
 
 #include <cstdint>
@@ -34,6 +35,7 @@ struct DicomLayout {
   std::string transfer_syntax;  // its UID
   bool encapsulated = false;    // compressed: each frame's fragments are a JPEG, JPEG 2000 or RLE stream
   bool rle = false;             // RLE lossless: decoded by decode_rle_frame()
+  bool video = false;           // MPEG-2, H.264 or HEVC: the fragments hold one video stream, not a frame each
   double fps = 0;               // from the frame time (vector) or the cine rate; 0 when the file gives none
   // The first 2D ultrasound region's pixel size (0018,6011: PhysicalDeltaX
   // and Y in cm), in mm; 0 when the file gives none.
@@ -49,7 +51,7 @@ struct DicomLayout {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> fragments;
   std::vector<std::size_t> first_fragment;
 
-  // Frame k's bytes as (offset, length) spans.
+  // Frame k's bytes as (offset, length) spans (a video: the stream's, as frame 0's).
   std::vector<std::pair<std::uint64_t, std::uint64_t>> frame_spans(int k) const;
 };
 

@@ -21,6 +21,10 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <tiffio.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include "captured_stderr.hpp"
 #include "dicom.hpp"
@@ -28,6 +32,7 @@
 #include "video_backend.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "gtrack/text_file.hpp"
 
 namespace gtrack {
 
@@ -146,8 +151,9 @@ class VideoSource final : public FrameSource {
     fps_ = cap_.get(cv::CAP_PROP_FPS);
     rate_declared_ = fps_ > 0 && fps_ < 1e4;
     if (!rate_declared_) fps_ = fallback_fps;
-    count_ = live ? -1 : static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_COUNT));
-    if (count_ <= 0 && !live) count_ = -1;
+    // A raw stream's count is whatever its duration gives (often nonsense).
+    const double count = live ? -1 : cap_.get(cv::CAP_PROP_FRAME_COUNT);
+    count_ = count >= 1 && count < 1e9 ? static_cast<int>(count) : -1;
     if (seek && !live && range.first > 0) {
       detail::CapturedStderr library;
       if (cap_.set(cv::CAP_PROP_POS_FRAMES, range.first)) {
@@ -498,9 +504,10 @@ cv::Mat read_dicom_image(const fs::path& p, std::string& said) {
     std::ifstream in(p, std::ios::binary);
     if (!in) throw InputError(p.string() + ": cannot open the file");
     const detail::DicomLayout layout = detail::read_dicom_layout(in, p.string());
-    if (layout.frames != 1) {
-      throw detail::DicomRefusal(p.string() + ": a DICOM file of " + std::to_string(layout.frames) +
-                                 " frames in a folder of images; give the file itself as --input");
+    if (layout.frames != 1 || layout.video) {
+      throw detail::DicomRefusal(p.string() + ": a DICOM file of " + std::to_string(layout.frames) + " frame" +
+                                 (layout.frames == 1 ? "" : "s") + (layout.video ? " as a video stream" : "") +
+                                 " in a folder of images; give the file itself as --input");
     }
     said.clear();
     return decode_dicom_frame(layout, in, 0, p.string());
@@ -1090,6 +1097,43 @@ class StackSource final : public FrameSource {
 
 // A DICOM file: its frames in order (a B-mode cine loop exported by a
 // scanner, or a single image), at the frame rate it gives.
+std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
+                                        double fallback_fps, bool seek, const std::string& name = {});
+
+// A file of this process's own in the temporary folder, removed with it.
+class TemporaryFile {
+ public:
+  // Holds `bytes`; InputError naming `what` when it cannot be written.
+  TemporaryFile(const std::string& stem, const std::function<void(std::ostream&)>& write, const std::string& what) {
+    std::string pattern = (fs::temp_directory_path() / (stem + "_XXXXXX")).string();
+    const int fd = ::mkstemp(pattern.data());
+    if (fd < 0) {
+      throw InputError(what + ": cannot make a file in " + fs::temp_directory_path().string() + " (" +
+                       std::strerror(errno) + ")");
+    }
+    ::close(fd);
+    path_ = pattern;
+    std::ofstream out(path_, std::ios::binary | std::ios::trunc);
+    write(out);
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(path_, ec);
+      throw InputError(what + ": cannot write " + path_.string() + " (" + write_failure_reason() + ")");
+    }
+  }
+  ~TemporaryFile() {
+    std::error_code ec;
+    fs::remove(path_, ec);
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
 class DicomSource final : public FrameSource {
  public:
   DicomSource(std::string spec, ImageSize expected, FrameRange range, double fallback_fps)
@@ -1103,11 +1147,37 @@ class DicomSource final : public FrameSource {
     logger().debug("{}: DICOM, {} frame(s) of {}x{}, {} sample(s) of {} bits, {}, {}, {} frames/s", spec_,
                    layout_.frames, layout_.columns, layout_.rows, layout_.samples, layout_.bits_allocated,
                    layout_.photometric, detail::transfer_syntax_name(layout_.transfer_syntax), layout_.fps);
+    if (layout_.video) {
+      // The stream, as the scanner encoded it, in a file of its own for the
+      // video decoder (which finds its container, or none, by its content).
+      stream_.emplace(
+          "gtrack_dicom_video",
+          [&](std::ostream& out) {
+            std::vector<char> buffer;
+            for (const auto& [offset, length] : layout_.frame_spans(0)) {
+              buffer.resize(length);
+              in_.clear();
+              in_.seekg(static_cast<std::streamoff>(offset));
+              if (!in_.read(buffer.data(), static_cast<std::streamsize>(length))) {
+                throw InputError(spec_ + ": its video stream cannot be read (the file changed since it was opened)");
+              }
+              out.write(buffer.data(), static_cast<std::streamsize>(length));
+            }
+          },
+          spec_);
+      video_ = open_video(stream_->path().string(), expected, range, time_fps_, false, spec_);
+    }
   }
 
   std::optional<Frame> next() override {
     if (!warned_ && !quiet() && !layout_.cut_short.empty()) logger().warn("{}: {}", spec_, layout_.cut_short);
     warned_ = true;
+    if (video_) {
+      auto f = video_->next();
+      // The file's rate, when it gives one, over the stream's.
+      if (f && layout_.fps > 0) f->time_s = f->index / layout_.fps;
+      return f;
+    }
     while (index_ < layout_.frames && !filter_.done(index_) && !filter_.wanted(index_)) ++index_;
     if (index_ >= layout_.frames || filter_.done(index_)) return std::nullopt;
     Frame f;
@@ -1119,9 +1189,11 @@ class DicomSource final : public FrameSource {
     ++index_;
     return f;
   }
-  double fps() const override { return layout_.fps; }
+  double fps() const override { return layout_.fps > 0 || !video_ ? layout_.fps : video_->fps(); }
   int frame_count() const override { return layout_.frames; }
-  std::string ended_early() const override { return layout_.cut_short; }
+  std::string ended_early() const override {
+    return video_ && !video_->ended_early().empty() ? video_->ended_early() : layout_.cut_short;
+  }
   std::optional<std::pair<double, double>> pixel_size_mm() const override {
     if (!(layout_.region_mm_x > 0 && layout_.region_mm_y > 0)) return std::nullopt;
     return std::make_pair(layout_.region_mm_x, layout_.region_mm_y);
@@ -1140,12 +1212,17 @@ class DicomSource final : public FrameSource {
   double time_fps_ = 30;
   int index_ = 0;
   bool warned_ = false;  // of a file cut short, at the first frame
+  std::optional<TemporaryFile> stream_;  // a video's stream, for video_ (which goes first)
+  std::unique_ptr<VideoSource> video_;
 };
 
+// `name`: the file named in messages and frame names (a DICOM file whose
+// stream is in `spec`); "" for `spec` itself.
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
-                                        double fallback_fps, bool seek) {
+                                        double fallback_fps, bool seek, const std::string& name) {
   std::error_code ec;
   if (!fs::exists(spec, ec)) throw InputError(spec + ": no such file or folder");
+  const std::string& shown = name.empty() ? spec : name;
   cv::VideoCapture cap;
   // The error below says in a line what the decoder says.
   bool opened = false;
@@ -1157,13 +1234,14 @@ std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expec
   }
   if (!opened) {
     if (fs::is_regular_file(spec, ec) && fs::file_size(spec, ec) == 0) {
-      throw InputError(spec + ": an empty file (0 bytes); expected a video, a folder of images or a TIFF stack");
+      throw InputError(shown + ": an empty file (0 bytes); expected a video, a folder of images or a TIFF stack");
     }
-    throw InputError(spec + ": cannot open as a video (corrupt, unsupported, or holding no frame" +
+    throw InputError(shown + ": cannot open " + (name.empty() ? "as a video" : "its video stream") +
+                     " (corrupt, unsupported, or holding no frame" +
                      (said.empty() ? std::string() : "; the decoder said: " + said) + ")");
   }
-  if (!said.empty()) logger().debug("{}: the decoder said: {}", spec, said);
-  return std::make_unique<VideoSource>(std::move(cap), spec, expected, range, fallback_fps, false, seek);
+  if (!said.empty()) logger().debug("{}: the decoder said: {}", shown, said);
+  return std::make_unique<VideoSource>(std::move(cap), shown, expected, range, fallback_fps, false, seek);
 }
 
 // What a frame's pixels were, to tell whether a frame read again is the same.
