@@ -19,6 +19,7 @@
 #include "gtrack/setup.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/two_pass.hpp"
+#include "gtrack/udp_sender.hpp"
 
 namespace po = boost::program_options;
 
@@ -132,6 +133,16 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
       }
     };
   }
+  // --stream-udp: each estimate, as its estimates.jsonl line, in a UDP
+  // datagram (for a controller in another process or on another machine).
+  std::optional<gtrack::UdpSender> udp;
+  if (vm.count("stream-udp")) {
+    udp.emplace(vm["stream-udp"].as<std::string>(), "--stream-udp");
+    opt.on_frame = [&udp, streamed = opt.on_frame](const gtrack::Estimate& e) {
+      if (streamed) streamed(e);
+      udp->send(gtrack::estimate_json(e) + "\n");
+    };
+  }
   // --two-pass: the estimates are kept as they are made, for the backward
   // pass that follows the forward one.
   const bool two_pass = vm.count("two-pass") > 0;
@@ -206,6 +217,10 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (s.skipped_frames > 0) {
     std::fprintf(report, "%d frames left out for newer ones (--newest)\n", s.skipped_frames);
   }
+  if (udp) {
+    std::fprintf(report, "--stream-udp: %lld datagram%s sent to %s, %lld dropped\n", udp->sent(),
+                 udp->sent() == 1 ? "" : "s", udp->peer().c_str(), udp->dropped());
+  }
   if (s.resumed_after >= 0) {
     std::fprintf(report, "resumed after frame %d: %d frames were already done\n", s.resumed_after, s.frames_before);
   }
@@ -258,6 +273,9 @@ GTRACK_COMMAND(
           "durable", "put each frame's estimates and the tracker state on the disk (fsync) before the next frame: "
                      "a power loss then loses no finished frame")(
           "stream", "also print each estimate (its estimates.jsonl line) on stdout as soon as it is made")(
+          "stream-udp", po::value<std::string>(),
+          "HOST:PORT: also send each estimate (its estimates.jsonl line) as a UDP datagram as soon as it is made, "
+          "to a controller in another process or on another machine")(
           "follow-stimulus", "the stimulus log is still being written: each frame takes its latest row")(
           "newest",
           "a live source (camera:N, --follow-input) faster than the tracker: track the newest frame each time, "

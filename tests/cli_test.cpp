@@ -1,6 +1,11 @@
 // The gtrack executable as a user runs it: exit codes and one-line errors.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 
 #include <array>
@@ -165,6 +170,52 @@ TEST(Cli, StreamPrintsEachEstimateOnStdout) {
   EXPECT_EQ(lines(r.output), 3) << r.output;
   EXPECT_EQ(r.output, written);
   EXPECT_EQ(r.output.rfind("{\"frame\":0,", 0), 0u) << r.output;
+}
+
+// --stream-udp: each estimate also goes to a UDP port as one datagram, its
+// estimates.jsonl line, for a controller in another process; nobody
+// listening stops nothing; a bad address is one line.
+TEST(Cli, StreamUdpSendsEachEstimateAsADatagram) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "stream_udp";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 3 --seed 2 --out " + dir.string()).code, 0);
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in at{};
+  at.sin_family = AF_INET;
+  at.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  at.sin_port = 0;  // a free port
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&at), sizeof at), 0);
+  socklen_t length = sizeof at;
+  ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&at), &length), 0);
+  const std::string port = std::to_string(ntohs(at.sin_port));
+  const CliRun r =
+      gtrack(track_of(dir) + " -o " + (dir / "out").string() + " --no-overlay --stream-udp 127.0.0.1:" + port);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("--stream-udp: 3 datagrams sent to 127.0.0.1:" + port + ", 0 dropped"), std::string::npos)
+      << r.output;
+  // The datagrams wait in the socket's buffer: each one line of the file.
+  std::string received;
+  int datagrams = 0;
+  std::array<char, 65536> buffer;
+  for (ssize_t n; (n = ::recv(fd, buffer.data(), buffer.size(), MSG_DONTWAIT)) > 0; ++datagrams) {
+    const std::string one(buffer.data(), static_cast<std::size_t>(n));
+    EXPECT_EQ(lines(one), 1) << one;
+    received += one;
+  }
+  ::close(fd);
+  EXPECT_EQ(datagrams, 3);
+  EXPECT_EQ(received, read_file(dir / "out" / "estimates.jsonl"));
+  // Nobody listens there now: the run is the same.
+  const CliRun unheard =
+      gtrack(track_of(dir) + " -o " + (dir / "out2").string() + " --no-overlay --stream-udp localhost:" + port);
+  EXPECT_EQ(unheard.code, 0) << unheard.output;
+  EXPECT_EQ(lines(read_file(dir / "out2" / "estimates.jsonl")), 3);
+  for (const std::string& bad : {std::string("5005"), std::string("localhost:0"), std::string("localhost:70000"),
+                                 std::string("[::1:5005"), std::string("localhost:50x5")}) {
+    const CliRun refused = gtrack(track_of(dir) + " -o " + (dir / "out3").string() + " --stream-udp " + bad);
+    expect_refusal(refused, "--stream-udp '" + bad + "': ");
+  }
 }
 
 // The reader of --stream goes away (`| head -n 1`): the run stops at the

@@ -685,6 +685,8 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
     }
     if (h.length > r.size() - h.value_at) {
       ended = "its compressed pixel data ends within a fragment";
+      // A video's stream is decoded up to where it stops.
+      if (out.video && !first && r.size() > h.value_at) out.fragments.emplace_back(h.value_at, r.size() - h.value_at);
       break;
     }
     if (first) {
@@ -702,9 +704,11 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   if (out.fragments.empty()) throw InputError(name + ": its compressed pixel data holds no fragment; expected a frame");
   if (out.video) {
     // One stream in every fragment, whatever the frames: the decoder finds
-    // them, and says where a stream cut short ends.
+    // them, up to where a stream cut short stops (whole fragments with
+    // only the end mark missing are the whole stream, or its frames fall
+    // short of the file's count, which the source says).
     out.first_fragment = {0};
-    if (!ended.empty()) out.cut_short = ended + "; the frames of its video stream up to there are read";
+    if (!ended.empty() && !at_boundary) out.cut_short = ended + "; the frames of its video stream up to there are read";
     return out;
   }
   const std::size_t frames = static_cast<std::size_t>(out.frames);

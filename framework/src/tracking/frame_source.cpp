@@ -219,6 +219,10 @@ class VideoSource final : public FrameSource {
   std::string ended_early() const override { return ended_early_; }
   // Whether the source was positioned by seeking (`seek`, and the decoder took it).
   bool seeked() const { return seeked_; }
+  // Whether the video gives its rate (else fps() is the fallback's).
+  bool rate_declared() const { return rate_declared_; }
+  // The frames grabbed so far (at the end: where the stream or the range stopped).
+  int position() const { return index_; }
 
  private:
   // What the decoder said while taking frame index_ (`taken`: into an
@@ -1100,35 +1104,45 @@ class StackSource final : public FrameSource {
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
                                         double fallback_fps, bool seek, const std::string& name = {});
 
-// A file of this process's own in the temporary folder, removed with it.
+// A file of this process's own in the temporary folder ($TMPDIR, else
+// /tmp), removed with it (or before: whoever opened it keeps reading it).
 class TemporaryFile {
  public:
-  // Holds `bytes`; InputError naming `what` when it cannot be written.
+  // Holds what `write` gives it; InputError naming `what` when it cannot
+  // be made or written (nothing is left behind then).
   TemporaryFile(const std::string& stem, const std::function<void(std::ostream&)>& write, const std::string& what) {
-    std::string pattern = (fs::temp_directory_path() / (stem + "_XXXXXX")).string();
+    std::error_code ec;
+    const fs::path dir = fs::temp_directory_path(ec);
+    if (ec) {
+      throw InputError(what + ": no temporary folder to copy its stream to (TMPDIR: " + ec.message() +
+                       "); expected TMPDIR to name a writable folder");
+    }
+    std::string pattern = (dir / (stem + "_XXXXXX")).string();
     const int fd = ::mkstemp(pattern.data());
     if (fd < 0) {
-      throw InputError(what + ": cannot make a file in " + fs::temp_directory_path().string() + " (" +
-                       std::strerror(errno) + ")");
+      throw InputError(what + ": cannot make a file in " + dir.string() + " (" + std::strerror(errno) +
+                       "); expected TMPDIR to name a writable folder");
     }
     ::close(fd);
     path_ = pattern;
-    std::ofstream out(path_, std::ios::binary | std::ios::trunc);
-    write(out);
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(path_, ec);
-      throw InputError(what + ": cannot write " + path_.string() + " (" + write_failure_reason() + ")");
+    try {
+      std::ofstream out(path_, std::ios::binary | std::ios::trunc);
+      write(out);
+      out.flush();
+      if (!out) throw InputError(what + ": cannot write " + path_.string() + " (" + write_failure_reason() + ")");
+    } catch (...) {
+      remove();
+      throw;
     }
   }
-  ~TemporaryFile() {
-    std::error_code ec;
-    fs::remove(path_, ec);
-  }
+  ~TemporaryFile() { remove(); }
   TemporaryFile(const TemporaryFile&) = delete;
   TemporaryFile& operator=(const TemporaryFile&) = delete;
   const fs::path& path() const { return path_; }
+  void remove() {
+    std::error_code ec;
+    if (!path_.empty()) fs::remove(path_, ec);
+  }
 
  private:
   fs::path path_;
@@ -1150,22 +1164,27 @@ class DicomSource final : public FrameSource {
     if (layout_.video) {
       // The stream, as the scanner encoded it, in a file of its own for the
       // video decoder (which finds its container, or none, by its content).
-      stream_.emplace(
+      // Removed once the decoder has opened it (it reads on from its own
+      // descriptor): nothing is left behind, however the run ends.
+      TemporaryFile stream(
           "gtrack_dicom_video",
           [&](std::ostream& out) {
-            std::vector<char> buffer;
+            std::vector<char> buffer(std::size_t(1) << 20);
             for (const auto& [offset, length] : layout_.frame_spans(0)) {
-              buffer.resize(length);
               in_.clear();
               in_.seekg(static_cast<std::streamoff>(offset));
-              if (!in_.read(buffer.data(), static_cast<std::streamsize>(length))) {
-                throw InputError(spec_ + ": its video stream cannot be read (the file changed since it was opened)");
+              for (std::uint64_t done = 0; done < length;) {
+                const auto n = static_cast<std::streamsize>(std::min<std::uint64_t>(buffer.size(), length - done));
+                if (!in_.read(buffer.data(), n)) {
+                  throw InputError(spec_ + ": its video stream cannot be read (the file changed since it was opened)");
+                }
+                out.write(buffer.data(), n);
+                done += static_cast<std::uint64_t>(n);
               }
-              out.write(buffer.data(), static_cast<std::streamsize>(length));
             }
           },
           spec_);
-      video_ = open_video(stream_->path().string(), expected, range, time_fps_, false, spec_);
+      video_ = open_video(stream.path().string(), expected, range, time_fps_, false, spec_);
     }
   }
 
@@ -1176,6 +1195,15 @@ class DicomSource final : public FrameSource {
       auto f = video_->next();
       // The file's rate, when it gives one, over the stream's.
       if (f && layout_.fps > 0) f->time_s = f->index / layout_.fps;
+      // The stream ended, not the range, before the file's count of frames.
+      const int at = video_->position();
+      if (!f && ended_early_.empty() && video_->ended_early().empty() && layout_.cut_short.empty() &&
+          layout_.frames > 1 &&
+          at < layout_.frames && !filter_.done(at)) {
+        ended_early_ = "its video stream holds " + std::to_string(at) + " frame" + (at == 1 ? "" : "s") +
+                       "; the file says " + std::to_string(layout_.frames) + " (0028,0008)";
+        if (!quiet()) logger().warn("{}: {}", spec_, ended_early_);
+      }
       return f;
     }
     while (index_ < layout_.frames && !filter_.done(index_) && !filter_.wanted(index_)) ++index_;
@@ -1189,10 +1217,17 @@ class DicomSource final : public FrameSource {
     ++index_;
     return f;
   }
-  double fps() const override { return layout_.fps > 0 || !video_ ? layout_.fps : video_->fps(); }
-  int frame_count() const override { return layout_.frames; }
+  // A video's rate when the file gives none: the stream's, when it gives one.
+  double fps() const override {
+    return layout_.fps > 0 || !video_ || !video_->rate_declared() ? layout_.fps : video_->fps();
+  }
+  int frame_count() const override {
+    // A video without its number of frames (0028,0008): the stream's count.
+    return video_ && layout_.frames == 1 ? video_->frame_count() : layout_.frames;
+  }
   std::string ended_early() const override {
-    return video_ && !video_->ended_early().empty() ? video_->ended_early() : layout_.cut_short;
+    if (video_ && !video_->ended_early().empty()) return video_->ended_early();
+    return ended_early_.empty() ? layout_.cut_short : ended_early_;
   }
   std::optional<std::pair<double, double>> pixel_size_mm() const override {
     if (!(layout_.region_mm_x > 0 && layout_.region_mm_y > 0)) return std::nullopt;
@@ -1212,8 +1247,8 @@ class DicomSource final : public FrameSource {
   double time_fps_ = 30;
   int index_ = 0;
   bool warned_ = false;  // of a file cut short, at the first frame
-  std::optional<TemporaryFile> stream_;  // a video's stream, for video_ (which goes first)
-  std::unique_ptr<VideoSource> video_;
+  std::unique_ptr<VideoSource> video_;  // a video's stream
+  std::string ended_early_;             // a video's frames short of the file's count
 };
 
 // `name`: the file named in messages and frame names (a DICOM file whose
@@ -1234,7 +1269,9 @@ std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expec
   }
   if (!opened) {
     if (fs::is_regular_file(spec, ec) && fs::file_size(spec, ec) == 0) {
-      throw InputError(shown + ": an empty file (0 bytes); expected a video, a folder of images or a TIFF stack");
+      throw InputError(shown + (name.empty() ? ": an empty file (0 bytes); expected a video, a folder of images or a "
+                                               "TIFF stack"
+                                             : ": its video stream holds no bytes; expected a video"));
     }
     throw InputError(shown + ": cannot open " + (name.empty() ? "as a video" : "its video stream") +
                      " (corrupt, unsupported, or holding no frame" +

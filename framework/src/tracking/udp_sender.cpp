@@ -1,0 +1,109 @@
+// UDP datagrams to a controller (see udp_sender.hpp).
+#include "gtrack/udp_sender.hpp"
+
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+
+#include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
+
+namespace gtrack {
+
+UdpSender::UdpSender(const std::string& address, const std::string& what) : what_(what) {
+  const auto refuse = [&](const std::string& why) {
+    throw InputError(what + " '" + address + "': " + why);
+  };
+  // HOST:PORT, the host in brackets when it is an IPv6 address.
+  std::string host, port;
+  if (!address.empty() && address.front() == '[') {
+    const auto close = address.find(']');
+    if (close == std::string::npos || close + 1 >= address.size() || address[close + 1] != ':') {
+      refuse("expected [IPv6]:PORT, e.g. [::1]:5005");
+    }
+    host = address.substr(1, close - 1);
+    port = address.substr(close + 2);
+  } else {
+    const auto colon = address.rfind(':');
+    if (colon == std::string::npos || address.find(':') != colon) {
+      refuse("expected HOST:PORT, e.g. 127.0.0.1:5005 (an IPv6 address in brackets: [::1]:5005)");
+    }
+    host = address.substr(0, colon);
+    port = address.substr(colon + 1);
+  }
+  int number = 0;
+  const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), number);
+  if (host.empty() || port.empty() || ec != std::errc() || end != port.data() + port.size() || number < 1 ||
+      number > 65535) {
+    refuse("expected HOST:PORT with a host and a port from 1 to 65535");
+  }
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_DGRAM;
+  hints.ai_flags = AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  if (const int r = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found); r != 0) {
+    refuse(std::string("cannot resolve the host (") + ::gai_strerror(r) + ")");
+  }
+  std::string why = "no address";
+  static_assert(sizeof(to_) >= sizeof(sockaddr_in6));
+  for (addrinfo* a = found; a; a = a->ai_next) {
+    const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) {
+      why = std::strerror(errno);
+      continue;
+    }
+    // Not connected: a peer with nobody listening (ICMP port unreachable)
+    // does not turn later sends into errors; a controller started late
+    // takes the datagrams from then on.
+    if (a->ai_addrlen > sizeof to_) {
+      ::close(fd);
+      continue;
+    }
+    std::memcpy(to_, a->ai_addr, a->ai_addrlen);
+    to_length_ = a->ai_addrlen;
+    char text[INET6_ADDRSTRLEN] = {};
+    const void* in = a->ai_family == AF_INET6 ? static_cast<const void*>(&reinterpret_cast<sockaddr_in6*>(a->ai_addr)->sin6_addr)
+                                              : static_cast<const void*>(&reinterpret_cast<sockaddr_in*>(a->ai_addr)->sin_addr);
+    ::inet_ntop(a->ai_family, in, text, sizeof text);
+    peer_ = a->ai_family == AF_INET6 ? "[" + std::string(text) + "]:" + port : std::string(text) + ":" + port;
+    fd_ = fd;
+    break;
+  }
+  ::freeaddrinfo(found);
+  if (fd_ < 0) refuse("cannot make a socket for it (" + why + ")");
+}
+
+UdpSender::~UdpSender() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool UdpSender::send(std::string_view datagram) {
+  for (;;) {
+    if (::sendto(fd_, datagram.data(), datagram.size(), MSG_DONTWAIT | MSG_NOSIGNAL,
+                 reinterpret_cast<const sockaddr*>(to_), to_length_) >= 0) {
+      ++sent_;
+      return true;
+    }
+    if (errno != EINTR) break;
+  }
+  const int error = errno;
+  ++dropped_;
+  if (error != last_error_) {
+    last_error_ = error;
+    const char* cause = error == EAGAIN || error == EWOULDBLOCK ? "the socket's buffer is full"
+                        : error == EMSGSIZE                        ? "the datagram is too large"
+                                                                   : "the network refused it";
+    logger().warn("{} {}: a datagram was dropped: {} ({}); the run goes on, and later drops for this cause are "
+                  "counted, not said",
+                  what_, peer_, cause, std::strerror(error));
+  }
+  return false;
+}
+
+}  // namespace gtrack
