@@ -466,14 +466,18 @@ TEST(Dicom, AVideoStreamIsReadAsItsFrames) {
   const std::string mpeg2 = stream_of("stream.mpg", cv::VideoWriter::fourcc('M', 'P', 'G', '2'));
   const std::string h264 = stream_of("stream.ts", cv::VideoWriter::fourcc('H', '2', '6', '4'));
   if (mpeg2.empty() || h264.empty()) GTEST_SKIP() << "this machine's OpenCV writes no MPEG-2 or no H.264 video";
+  // HEVC where the machine's encoder has it (Debian's does, through x265).
+  const std::string hevc = stream_of("stream_hevc.ts", cv::VideoWriter::fourcc('H', 'E', 'V', 'C'));
   DicomWriteOptions o;
   o.fragments_per_frame = 3;
   o.frame_time_ms = 50;
   o.photometric = "YBR_PARTIAL_420";
   for (const auto& [syntax, stream] : {std::pair<std::string, std::string>{"1.2.840.10008.1.2.4.100", mpeg2},
+                                       {"1.2.840.10008.1.2.4.107", hevc},
                                        {"1.2.840.10008.1.2.4.102", h264},
                                        {"1.2.840.10008.1.2.4.102.1", h264}}) {
     SCOPED_TRACE(syntax);
+    if (stream.empty()) continue;
     o.transfer_syntax = syntax;
     o.video = stream;
     write_dicom(dir / "video.dcm", written, o);

@@ -1225,9 +1225,12 @@ class DicomSource final : public FrameSource {
     // A video without its number of frames (0028,0008): the stream's count.
     return video_ && layout_.frames == 1 ? video_->frame_count() : layout_.frames;
   }
+  // The file cut short, else the decoder's stop, else a stream short of the
+  // file's count.
   std::string ended_early() const override {
+    if (!layout_.cut_short.empty()) return layout_.cut_short;
     if (video_ && !video_->ended_early().empty()) return video_->ended_early();
-    return ended_early_.empty() ? layout_.cut_short : ended_early_;
+    return ended_early_;
   }
   std::optional<std::pair<double, double>> pixel_size_mm() const override {
     if (!(layout_.region_mm_x > 0 && layout_.region_mm_y > 0)) return std::nullopt;

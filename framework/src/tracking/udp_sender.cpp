@@ -58,20 +58,24 @@ UdpSender::UdpSender(const std::string& address, const std::string& what) : what
       why = std::strerror(errno);
       continue;
     }
-    // Not connected: a peer with nobody listening (ICMP port unreachable)
-    // does not turn later sends into errors; a controller started late
-    // takes the datagrams from then on.
     if (a->ai_addrlen > sizeof to_) {
       ::close(fd);
       continue;
     }
+    // Not connected: a peer with nobody listening (ICMP port unreachable)
+    // does not turn later sends into errors; a controller started late
+    // takes the datagrams from then on. A subnet's broadcast address
+    // (192.168.1.255) is taken as any other.
+    const int yes = 1;
+    if (a->ai_family == AF_INET) ::setsockopt(fd, SOL_SOCKET, SO_BROADCAST, &yes, sizeof yes);
     std::memcpy(to_, a->ai_addr, a->ai_addrlen);
     to_length_ = a->ai_addrlen;
     char text[INET6_ADDRSTRLEN] = {};
-    const void* in = a->ai_family == AF_INET6 ? static_cast<const void*>(&reinterpret_cast<sockaddr_in6*>(a->ai_addr)->sin6_addr)
-                                              : static_cast<const void*>(&reinterpret_cast<sockaddr_in*>(a->ai_addr)->sin_addr);
-    ::inet_ntop(a->ai_family, in, text, sizeof text);
-    peer_ = a->ai_family == AF_INET6 ? "[" + std::string(text) + "]:" + port : std::string(text) + ":" + port;
+    const bool v6 = a->ai_family == AF_INET6;
+    const void* ip = v6 ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr)
+                        : static_cast<const void*>(&reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr);
+    ::inet_ntop(a->ai_family, ip, text, sizeof text);
+    peer_ = v6 ? "[" + std::string(text) + "]:" + port : std::string(text) + ":" + port;
     fd_ = fd;
     break;
   }
