@@ -1099,8 +1099,6 @@ class StackSource final : public FrameSource {
   std::string ended_early_;             // the directories end in an error
 };
 
-// A DICOM file: its frames in order (a B-mode cine loop exported by a
-// scanner, or a single image), at the frame rate it gives.
 std::unique_ptr<VideoSource> open_video(const std::string& spec, ImageSize expected, FrameRange range,
                                         double fallback_fps, bool seek, const std::string& name = {});
 
@@ -1148,6 +1146,8 @@ class TemporaryFile {
   fs::path path_;
 };
 
+// A DICOM file: its frames in order (a B-mode cine loop exported by a
+// scanner, or a single image), at the frame rate it gives.
 class DicomSource final : public FrameSource {
  public:
   DicomSource(std::string spec, ImageSize expected, FrameRange range, double fallback_fps)
@@ -1198,8 +1198,7 @@ class DicomSource final : public FrameSource {
       // The stream ended, not the range, before the file's count of frames.
       const int at = video_->position();
       if (!f && ended_early_.empty() && video_->ended_early().empty() && layout_.cut_short.empty() &&
-          layout_.frames > 1 &&
-          at < layout_.frames && !filter_.done(at)) {
+          layout_.frames > 1 && at < layout_.frames && !filter_.done(at)) {
         ended_early_ = "its video stream holds " + std::to_string(at) + " frame" + (at == 1 ? "" : "s") +
                        "; the file says " + std::to_string(layout_.frames) + " (0028,0008)";
         if (!quiet()) logger().warn("{}: {}", spec_, ended_early_);
