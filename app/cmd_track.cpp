@@ -110,15 +110,24 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   }
   // --stream: each estimate, as its estimates.jsonl line, on stdout as soon
   // as it is made (for a controller reading a pipe); the rest goes to stderr.
+  // --stream-udp: the same line in a UDP datagram (for a controller in
+  // another process or on another machine), sent first: it never waits,
+  // where a slow pipe's reader can hold the write.
   const bool stream = vm.count("stream") > 0;
+  std::optional<gtrack::UdpSender> udp;
+  if (vm.count("stream-udp")) udp.emplace(vm["stream-udp"].as<std::string>(), "--stream-udp");
   if (stream) {
     // A reader that goes away (the controller stopped) ends the run like
     // Ctrl-C does, files closed, instead of SIGPIPE killing the process.
     std::signal(SIGPIPE, SIG_IGN);
     g_streaming = true;
-    opt.on_frame = [](const gtrack::Estimate& e) {
-      if (g_reader_gone || g_stream_stalled) return;
-      if (std::fputs((gtrack::estimate_json(e) + "\n").c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
+  }
+  if (stream || udp) {
+    opt.on_frame = [stream, &udp](const gtrack::Estimate& e) {
+      const std::string line = gtrack::estimate_json(e) + "\n";
+      if (udp) udp->send(line);
+      if (!stream || g_reader_gone || g_stream_stalled) return;
+      if (std::fputs(line.c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
         const int error = errno;
         if (g_grace_over && error != EPIPE) {
           g_stream_stalled = true;
@@ -131,16 +140,6 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
         }
         g_stop = true;
       }
-    };
-  }
-  // --stream-udp: each estimate, as its estimates.jsonl line, in a UDP
-  // datagram (for a controller in another process or on another machine).
-  std::optional<gtrack::UdpSender> udp;
-  if (vm.count("stream-udp")) {
-    udp.emplace(vm["stream-udp"].as<std::string>(), "--stream-udp");
-    opt.on_frame = [&udp, streamed = opt.on_frame](const gtrack::Estimate& e) {
-      if (streamed) streamed(e);
-      udp->send(gtrack::estimate_json(e) + "\n");
     };
   }
   // --two-pass: the estimates are kept as they are made, for the backward
@@ -218,7 +217,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     std::fprintf(report, "%d frames left out for newer ones (--newest)\n", s.skipped_frames);
   }
   if (udp) {
-    std::fprintf(report, "--stream-udp: %lld datagram%s sent to %s, %lld dropped\n", udp->sent(),
+    std::fprintf(report, "--stream-udp: %lld datagram%s handed to the network for %s, %lld dropped\n", udp->sent(),
                  udp->sent() == 1 ? "" : "s", udp->peer().c_str(), udp->dropped());
   }
   if (s.resumed_after >= 0) {

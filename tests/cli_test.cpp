@@ -192,7 +192,8 @@ TEST(Cli, StreamUdpSendsEachEstimateAsADatagram) {
   const CliRun r =
       gtrack(track_of(dir) + " -o " + (dir / "out").string() + " --no-overlay --stream-udp 127.0.0.1:" + port);
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("--stream-udp: 3 datagrams sent to 127.0.0.1:" + port + ", 0 dropped"), std::string::npos)
+  EXPECT_NE(r.output.find("--stream-udp: 3 datagrams handed to the network for 127.0.0.1:" + port + ", 0 dropped"),
+            std::string::npos)
       << r.output;
   // The datagrams wait in the socket's buffer: each one line of the file.
   std::string received;
@@ -208,11 +209,14 @@ TEST(Cli, StreamUdpSendsEachEstimateAsADatagram) {
   EXPECT_EQ(received, read_file(dir / "out" / "estimates.jsonl"));
   // Nobody listens there now: the run is the same.
   const CliRun unheard =
-      gtrack(track_of(dir) + " -o " + (dir / "out2").string() + " --no-overlay --stream-udp localhost:" + port);
+      gtrack(track_of(dir) + " -o " + (dir / "out2").string() + " --no-overlay --stream-udp 127.0.0.1:" + port);
   EXPECT_EQ(unheard.code, 0) << unheard.output;
+  EXPECT_NE(unheard.output.find("3 datagrams handed to the network for 127.0.0.1:" + port), std::string::npos)
+      << unheard.output;
   EXPECT_EQ(lines(read_file(dir / "out2" / "estimates.jsonl")), 3);
   for (const std::string& bad : {std::string("5005"), std::string("localhost:0"), std::string("localhost:70000"),
-                                 std::string("[::1:5005"), std::string("localhost:50x5")}) {
+                                 std::string("[::1:5005"), std::string("localhost:50x5"),
+                                 std::string("[fe80::1]:5005")}) {
     const CliRun refused = gtrack(track_of(dir) + " -o " + (dir / "out3").string() + " --stream-udp " + bad);
     expect_refusal(refused, "--stream-udp '" + bad + "': ");
   }

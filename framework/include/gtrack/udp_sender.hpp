@@ -9,6 +9,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gtrack/export.hpp"
 
@@ -16,7 +17,9 @@ namespace gtrack {
 
 class GTRACK_API UdpSender {
  public:
-  // `address`: "HOST:PORT" (a name or an IPv4 address) or "[IPv6]:PORT".
+  // `address`: "HOST:PORT" (a name or an IPv4 address) or "[IPv6]:PORT"
+  // (a link-local one with its interface, "[fe80::1%eth0]:PORT"). A name
+  // with both kinds of address is sent to on its IPv4 one.
   // InputError naming `what` (e.g. "--stream-udp") and the address when it
   // is malformed, does not resolve, or no socket can be made for it.
   UdpSender(const std::string& address, const std::string& what);
@@ -30,7 +33,7 @@ class GTRACK_API UdpSender {
 
   long long sent() const { return sent_; }
   long long dropped() const { return dropped_; }
-  // The address as resolved ("127.0.0.1:5005", "[::1]:5005").
+  // The address as resolved ("127.0.0.1:5005", "[::1]:5005", "[fe80::1%eth0]:5005").
   const std::string& peer() const { return peer_; }
 
  private:
@@ -39,7 +42,7 @@ class GTRACK_API UdpSender {
   unsigned to_length_ = 0;
   std::string what_, peer_;
   long long sent_ = 0, dropped_ = 0;
-  int last_error_ = 0;  // the errno of the last drop warned about
+  std::vector<int> warned_;  // the causes (errno) of drops warned about
 };
 
 }  // namespace gtrack

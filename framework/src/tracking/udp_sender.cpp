@@ -2,13 +2,16 @@
 #include "gtrack/udp_sender.hpp"
 
 #include <arpa/inet.h>
+#include <net/if.h>
 #include <netdb.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <vector>
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
@@ -45,14 +48,36 @@ UdpSender::UdpSender(const std::string& address, const std::string& what) : what
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_DGRAM;
-  hints.ai_flags = AI_NUMERICSERV;
+  // An address as written; else a name, resolved to the families this
+  // machine has an address of.
+  hints.ai_flags = AI_NUMERICSERV | AI_NUMERICHOST;
   addrinfo* found = nullptr;
-  if (const int r = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found); r != 0) {
-    refuse(std::string("cannot resolve the host (") + ::gai_strerror(r) + ")");
+  int r = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found);
+  if (r == EAI_NONAME) {
+    hints.ai_flags = AI_NUMERICSERV | AI_ADDRCONFIG;
+    r = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found);
+  }
+  if (r != 0) refuse(std::string("cannot resolve the host (") + ::gai_strerror(r) + ")");
+  // A name with both: its IPv4 address, which a controller bound to
+  // 0.0.0.0 (the usual) hears; "localhost" is often ::1 first.
+  std::vector<addrinfo*> order;
+  for (addrinfo* a = found; a; a = a->ai_next) {
+    if (a->ai_family == AF_INET) order.push_back(a);
+  }
+  for (addrinfo* a = found; a; a = a->ai_next) {
+    if (a->ai_family != AF_INET) order.push_back(a);
   }
   std::string why = "no address";
   static_assert(sizeof(to_) >= sizeof(sockaddr_in6));
-  for (addrinfo* a = found; a; a = a->ai_next) {
+  for (addrinfo* a : order) {
+    if (a->ai_family == AF_INET6) {
+      // A link-local address means nothing without its interface.
+      const auto* v6 = reinterpret_cast<const sockaddr_in6*>(a->ai_addr);
+      if (IN6_IS_ADDR_LINKLOCAL(&v6->sin6_addr) && v6->sin6_scope_id == 0) {
+        ::freeaddrinfo(found);
+        refuse("a link-local address needs its interface; expected [fe80::...%IFACE]:PORT, e.g. [fe80::1%eth0]:5005");
+      }
+    }
     const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
     if (fd < 0) {
       why = std::strerror(errno);
@@ -75,12 +100,20 @@ UdpSender::UdpSender(const std::string& address, const std::string& what) : what
     const void* ip = v6 ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr)
                         : static_cast<const void*>(&reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr);
     ::inet_ntop(a->ai_family, ip, text, sizeof text);
-    peer_ = v6 ? "[" + std::string(text) + "]:" + port : std::string(text) + ":" + port;
+    std::string shown = text;
+    if (v6) {
+      char name[IF_NAMESIZE] = {};
+      const unsigned scope = reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_scope_id;
+      if (scope != 0) shown += "%" + std::string(::if_indextoname(scope, name) ? name : std::to_string(scope).c_str());
+      shown = "[" + shown + "]";
+    }
+    peer_ = shown + ":" + std::to_string(number);
     fd_ = fd;
     break;
   }
   ::freeaddrinfo(found);
   if (fd_ < 0) refuse("cannot make a socket for it (" + why + ")");
+  logger().info("{}: each estimate goes to {} as a UDP datagram", what_, peer_);
 }
 
 UdpSender::~UdpSender() {
@@ -98,8 +131,8 @@ bool UdpSender::send(std::string_view datagram) {
   }
   const int error = errno;
   ++dropped_;
-  if (error != last_error_) {
-    last_error_ = error;
+  if (std::find(warned_.begin(), warned_.end(), error) == warned_.end()) {
+    warned_.push_back(error);
     const char* cause = error == EAGAIN || error == EWOULDBLOCK ? "the socket's buffer is full"
                         : error == EMSGSIZE                        ? "the datagram is too large"
                                                                    : "the network refused it";
