@@ -68,6 +68,12 @@ cv::Mat bgr(const cv::Mat& m) {
   return out;
 }
 
+// A whole file, byte for byte.
+std::string file_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 bool same(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
 }
@@ -321,11 +327,7 @@ TEST(Dicom, CompressedFramesAreDecodedFrameByFrame) {
   ASSERT_EQ(got.size(), 3u);
   EXPECT_TRUE(same(got[0], jpeg[0]));
   // Only the end mark missing: every frame is whole, and none is dropped.
-  std::string bytes;
-  {
-    std::ifstream in(dir / "jpeg.dcm", std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::string bytes = file_bytes(dir / "jpeg.dcm");
   std::ofstream(dir / "no_end.dcm", std::ios::binary) << bytes.substr(0, bytes.size() - 8);
   auto no_end = gtrack::open_frame_source((dir / "no_end.dcm").string(), {64, 48}, {}, 30);
   EXPECT_EQ(no_end->frame_count(), 3);
@@ -411,11 +413,7 @@ TEST(Dicom, RleFramesAreTheImagesWritten) {
             std::string::npos)
       << e;
   write_dicom(dir / "count.dcm", {cv::Mat(30, 40, CV_8UC3, cv::Scalar::all(9))}, o);
-  std::string bytes;
-  {
-    std::ifstream in(dir / "count.dcm", std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::string bytes = file_bytes(dir / "count.dcm");
   const std::size_t at = bytes.find(std::string("\x03\0\0\0\x40\0\0\0", 8));
   ASSERT_NE(at, std::string::npos);
   bytes[at] = 1;
@@ -460,8 +458,7 @@ TEST(Dicom, AVideoStreamIsReadAsItsFrames) {
       if (!w.isOpened()) return std::string();
       for (const cv::Mat& m : written) w << m;
     }
-    std::ifstream in(dir / file, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
+    return file_bytes(dir / file);
   };
   const std::string mpeg2 = stream_of("stream.mpg", cv::VideoWriter::fourcc('M', 'P', 'G', '2'));
   const std::string h264 = stream_of("stream.ts", cv::VideoWriter::fourcc('H', '2', '6', '4'));
@@ -503,11 +500,7 @@ TEST(Dicom, AVideoStreamIsReadAsItsFrames) {
   EXPECT_NE(gtrack::open_frame_source((dir / "video.dcm").string(), {128, 96}, {}, 30)->description().find(
                 "fragmentable MPEG-4 AVC/H.264 video (1.2.840.10008.1.2.4.102.1)"),
             std::string::npos);
-  std::string bytes;
-  {
-    std::ifstream in(dir / "video.dcm", std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::string bytes = file_bytes(dir / "video.dcm");
   // Only the end mark missing: every frame, and nothing said.
   std::ofstream(dir / "no_end.dcm", std::ios::binary) << bytes.substr(0, bytes.size() - 8);
   EXPECT_EQ(read_all(dir / "no_end.dcm", {128, 96}).size(), 12u);
@@ -573,11 +566,7 @@ TEST(Dicom, AFileItCannotTakeIsRefusedInALine) {
   const fs::path dir = dir_for("refused");
   const auto written = frames(2);
   write_dicom(dir / "whole.dcm", written);
-  std::string bytes;
-  {
-    std::ifstream in(dir / "whole.dcm", std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::string bytes = file_bytes(dir / "whole.dcm");
   // Cut short in the pixel data: its whole frames are read, and said.
   std::ofstream(dir / "short.dcm", std::ios::binary) << bytes.substr(0, bytes.size() - 100);
   auto cut = gtrack::open_frame_source((dir / "short.dcm").string(), {40, 30}, {}, 30);
@@ -668,10 +657,7 @@ TEST(Dicom, AnUltrasoundCineLoopIsTrackedAsItsFramesAre) {
   const auto folder = poses(dir / "from_folder" / "estimates.csv");
   EXPECT_EQ(folder.size(), 5u);
   EXPECT_EQ(poses(dir / "from_dicom" / "estimates.csv"), folder);
-  const auto log = [&] {
-    std::ifstream in(dir / "log.txt");
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
+  const auto log = [&] { return file_bytes(dir / "log.txt"); };
   EXPECT_EQ(log().find("its pixels are"), std::string::npos) << "the sensor's size: " << log();
   // A file whose pixels are not the sensor's size is warned about.
   o.region_cm_x = o.region_cm_y = 0.012;

@@ -263,6 +263,14 @@ class Reader {
   std::uint64_t at_ = 0;
 };
 
+// A video transfer syntax's fragmentable form (1.2.840.10008.1.2.4.100.1
+// to .108.1) as the syntax it is a form of; any other UID as it is.
+std::string unfragmented(const std::string& uid) {
+  const bool fragmentable = uid.rfind("1.2.840.10008.1.2.4.10", 0) == 0 && uid.size() > 2 &&
+                            uid.compare(uid.size() - 2, 2, ".1") == 0;
+  return fragmentable ? uid.substr(0, uid.size() - 2) : uid;
+}
+
 }  // namespace
 
 std::string transfer_syntax_name(const std::string& uid) {
@@ -293,13 +301,9 @@ std::string transfer_syntax_name(const std::string& uid) {
       {"1.2.840.10008.1.2.4.203", "high-throughput JPEG 2000"},
       {"1.2.840.10008.1.2.5", "RLE lossless"},
   }};
+  const std::string base = unfragmented(uid);
   for (const auto& [u, n] : kNames) {
-    if (uid == u) return std::string(n) + " (" + uid + ")";
-    // A video's fragmentable form.
-    if (uid.size() == std::strlen(u) + 2 && uid.rfind(u, 0) == 0 && uid.compare(uid.size() - 2, 2, ".1") == 0 &&
-        std::strstr(n, "video")) {
-      return "fragmentable " + std::string(n) + " (" + uid + ")";
-    }
+    if (base == u) return (base == uid ? "" : "fragmentable ") + std::string(n) + " (" + uid + ")";
   }
   return "transfer syntax " + uid;
 }
@@ -485,12 +489,7 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
       "1.2.840.10008.1.2.4.100", "1.2.840.10008.1.2.4.101", "1.2.840.10008.1.2.4.102",
       "1.2.840.10008.1.2.4.103", "1.2.840.10008.1.2.4.104", "1.2.840.10008.1.2.4.105",
       "1.2.840.10008.1.2.4.106", "1.2.840.10008.1.2.4.107", "1.2.840.10008.1.2.4.108"};
-  // Their fragmentable forms end in ".1" (1.2.840.10008.1.2.4.100.1, ...).
-  const std::string unfragmented = ts.size() > 2 && ts.compare(ts.size() - 2, 2, ".1") == 0 &&
-                                           ts.rfind("1.2.840.10008.1.2.4.10", 0) == 0
-                                       ? ts.substr(0, ts.size() - 2)
-                                       : ts;
-  const bool video = std::find(kVideo.begin(), kVideo.end(), unfragmented) != kVideo.end();
+  const bool video = std::find(kVideo.begin(), kVideo.end(), unfragmented(ts)) != kVideo.end();
   if (!native && !video && std::find(kCompressed.begin(), kCompressed.end(), ts) == kCompressed.end()) {
     throw DicomRefusal(name + ": its pixels are stored as " + transfer_syntax_name(ts) +
                      "; expected native pixels (explicit or implicit VR little endian), JPEG (baseline or extended), "

@@ -1137,12 +1137,12 @@ class TemporaryFile {
   TemporaryFile(const TemporaryFile&) = delete;
   TemporaryFile& operator=(const TemporaryFile&) = delete;
   const fs::path& path() const { return path_; }
-  void remove() {
-    std::error_code ec;
-    if (!path_.empty()) fs::remove(path_, ec);
-  }
 
  private:
+  void remove() {
+    std::error_code ec;
+    fs::remove(path_, ec);
+  }
   fs::path path_;
 };
 
