@@ -512,8 +512,8 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   EXPECT_EQ(s.lost_frames, 0);
   const auto csv = lines(opt.out_dir / "estimates.csv");
   ASSERT_EQ(csv.size(), 6u);
-  EXPECT_EQ(csv[0], "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,cost,status,ms");
-  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(fields(csv[i]), 16) << csv[i];
+  EXPECT_EQ(csv[0], "frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,cost,status,time_s,ms");
+  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(fields(csv[i]), 17) << csv[i];
   EXPECT_NE(csv[1].find(",search,"), std::string::npos);
   EXPECT_NE(csv[2].find(",ok,"), std::string::npos);
   const auto jsonl = lines(opt.out_dir / "estimates.jsonl");
@@ -521,6 +521,14 @@ TEST(TrackSequence, WritesEstimatesOverlayAndSummary) {
   EXPECT_NE(jsonl[4].find("\"stimulus\":30,"), std::string::npos) << jsonl[4];
   EXPECT_NE(jsonl[0].find("\"D\":"), std::string::npos);
   EXPECT_NE(jsonl[0].find("\"unseen_fingers\":["), std::string::npos) << jsonl[0];
+  // Each row's time is the frame's place at the folder's frame rate, the
+  // same in both files.
+  for (size_t i = 0; i < jsonl.size(); ++i) {
+    const std::string row = csv[i + 1].substr(0, csv[i + 1].rfind(','));  // less ms
+    const std::string t = row.substr(row.rfind(',') + 1);
+    EXPECT_NE(jsonl[i].find("\"time_s\":" + t + ","), std::string::npos) << csv[i + 1] << "\n" << jsonl[i];
+    EXPECT_NEAR(std::stod(t), static_cast<double>(i) / 30.0, 1e-6) << csv[i + 1];
+  }
   // Each row names its image and when it was written.
   EXPECT_NE(jsonl[4].find("\"image\":\"" + (seq / "frames" / "000004.png").string() + "\""), std::string::npos)
       << jsonl[4];
@@ -634,7 +642,7 @@ static void interrupt_leaves_complete_rows(int signal, const std::string& name, 
   EXPECT_GE(csv.size(), 3u);
   EXPECT_LT(csv.size(), 41u);
   EXPECT_EQ(jsonl.size() + 1, csv.size());
-  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(fields(csv[i]), 16);
+  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(fields(csv[i]), 17);
   for (const auto& j : jsonl) EXPECT_TRUE(j.front() == '{' && j.back() == '}') << j;
   EXPECT_TRUE(fs::exists(out / "summary.json"));
 }

@@ -2,9 +2,9 @@
 //
 // Rows are appended and flushed as soon as a frame is done, so a run that is
 // interrupted keeps every finished frame in well-formed files.
-// estimates.csv: frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,...,qF_deg,cost,status,ms
-// estimates.jsonl: one object per frame with the same fields plus time_s,
-// the cost terms D, K, S, the stimulus value, |O| and per-stage times.
+// estimates.csv: frame,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg,q1_deg,...,qF_deg,cost,status,time_s,ms
+// estimates.jsonl: one object per frame with the same fields plus the cost
+// terms D, K, S, the stimulus value, |O| and per-stage times.
 #pragma once
 
 #include <filesystem>

@@ -60,7 +60,7 @@ std::ofstream open_for_writing(const fs::path& p, bool append) {
 }
 
 // The header of estimates.csv: a pose table with the tracker's columns.
-std::string csv_header(int fingers) { return pose_table_header(fingers, {"cost", "status", "ms"}); }
+std::string csv_header(int fingers) { return pose_table_header(fingers, {"cost", "status", "time_s", "ms"}); }
 
 // Whole lines only: a last line without its newline was cut short.
 std::vector<std::string> complete_lines(const fs::path& p) {
@@ -135,7 +135,8 @@ void ResultWriter::write(const Estimate& e) {
   const Eigen::VectorXd& h = e.hypothesis;
   std::string row = std::to_string(e.frame);
   for (Eigen::Index i = 0; i < h.size(); ++i) row += "," + num(h[i], i < 3 ? "%.6f" : "%.4f");
-  row += "," + num(e.terms.total, "%.6f") + "," + to_string(e.status) + "," + num(e.ms, "%.3f") + "\n";
+  row += "," + num(e.terms.total, "%.6f") + "," + to_string(e.status) + "," + num(e.time_s, "%.6f") + "," +
+         num(e.ms, "%.3f") + "\n";
   csv_ << row;
   csv_.flush();
 
