@@ -31,13 +31,17 @@ void print_row(const char* name, const gtrack::ErrorStats& s, const char* unit) 
             << "  max " << std::setw(8) << s.max << " " << unit << "\n";
 }
 
-// What estimates.jsonl says of a frame: the occlusion allowance, and, from
-// 'gtrack track --score-truth', the estimate's and the truth's costs and how
-// much of the truth's silhouette fell outside O.
+// What estimates.jsonl says of a frame: the occlusion allowance, the tilt
+// margin, and, from 'gtrack track --score-truth', the estimate's and the
+// truth's costs and how much of the truth's silhouette fell outside O.
 struct FrameScores {
   double allowance = 0;
-  std::optional<double> cost, reference_cost, reference_outside;
+  std::optional<double> tilt_margin, cost, reference_cost, reference_outside;
 };
+
+// A tilt margin under this is a tilt whose sign the image barely decides
+// (docs/tracker.md, "How sure the tilt's sign is").
+constexpr double kNarrowTiltMargin = 0.1;
 
 // Per frame, from the estimates.jsonl beside the estimates (empty when there
 // is none).
@@ -62,6 +66,7 @@ std::map<int, FrameScores> frame_scores(const fs::path& estimates_csv) {
     FrameScores& s = out[static_cast<int>(*frame)];
     s.allowance = *allowance;
     s.cost = field(own, "cost");
+    s.tilt_margin = field(own, "tilt_margin");
     if (ref_at != std::string::npos) {
       const std::string ref = line.substr(ref_at, line.find('}', ref_at) - ref_at);
       s.reference_cost = field(ref, "cost");
@@ -93,7 +98,10 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
   const auto scores = frame_scores(estimates_csv);
   std::map<std::string, gtrack::ErrorSet> groups;
   const std::vector<std::string> order = {"unoccluded", "< 40 % hidden", ">= 40 % hidden", "partly out of view",
-                                          "unoccluded, no allowance", "unoccluded, an allowance left"};
+                                          "unoccluded, no allowance", "unoccluded, an allowance left",
+                                          fmt::format("tilt margin < {}", kNarrowTiltMargin),
+                                          fmt::format("tilt margin >= {}", kNarrowTiltMargin)};
+  std::map<std::string, int> other_branch;  // frames on the other branch of the tilt's sign, per group
   // With the truth scored (--score-truth): is the search or the cost short?
   const std::vector<std::string> why = {"truth scores lower", "truth spills over allowance", "truth scores no lower"};
   bool have_occlusion = false;
@@ -109,6 +117,11 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     groups[g].add(f.errors);
     const auto s = scores.find(f.frame);
     if (g == order[0] && s != scores.end()) groups[s->second.allowance > 0 ? order[5] : order[4]].add(f.errors);
+    if (s != scores.end() && s->second.tilt_margin) {
+      const std::string& t = *s->second.tilt_margin < kNarrowTiltMargin ? order[6] : order[7];
+      groups[t].add(f.errors);
+      other_branch[t] += f.errors.tilt_branch ? 1 : 0;
+    }
     if (s != scores.end() && s->second.cost && s->second.reference_cost) {
       const FrameScores& fs = s->second;
       const std::string& w = *fs.reference_cost < *fs.cost - kLowerBy ? why[0]
@@ -124,8 +137,8 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
                          : "  breakdown: the truth has no 'occluded' column (gtrack synth writes one)\n");
     return;
   }
-  std::cout << "  breakdown (in-view frames with an estimate; the allowance rows need estimates.jsonl, the last "
-               "three 'gtrack track --score-truth'):\n";
+  std::cout << "  breakdown (in-view frames with an estimate; the allowance and tilt margin rows need "
+               "estimates.jsonl, the last three 'gtrack track --score-truth'):\n";
   for (auto& [name, e] : groups) e.finish();
   // The three --score-truth groups split the same frames: each one's share of
   // their summed in-plane error.
@@ -146,6 +159,9 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
               << e.position_inplane_um.mean << " um (median " << e.position_inplane_um.median << ")  orientation "
               << std::setw(5) << e.orientation_deg.mean << " deg (median " << e.orientation_deg.median
               << ")  joints " << std::setprecision(2) << e.joint_deg.mean << " deg";
+    if (const auto b = other_branch.find(name); b != other_branch.end()) {
+      std::cout << "  (" << b->second << " on the other branch of the tilt's sign)";
+    }
     if (std::find(why.begin(), why.end(), name) != why.end() && inplane_total > 0) {
       std::cout << "  (" << std::setprecision(0) << 100 * inplane_sum(name) / inplane_total
                 << " % of the summed in-plane error)";

@@ -917,9 +917,10 @@ TEST(Cli, EvalRefusesMalformedTables) {
 }
 
 // eval --breakdown: every in-view frame with an estimate falls in exactly
-// one occlusion group, the unoccluded ones again by the allowance, and, with
-// the truth scored by the track (--score-truth), every frame in exactly one
-// of the three groups that say whether the truth scored lower.
+// one occlusion group, the unoccluded ones again by the allowance, those
+// with a tilt margin by it, and, with the truth scored by the track
+// (--score-truth), every frame in exactly one of the three groups that say
+// whether the truth scored lower.
 TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "breakdown";
   fs::remove_all(dir);
@@ -960,6 +961,15 @@ TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   EXPECT_EQ(groups["truth scores lower"] + groups["truth spills over allowance"] + groups["truth scores no lower"],
             evaluated)
       << r.output;
+  // The frames the mirror check ran on, by their tilt margin: each once.
+  int checked = 0;
+  {
+    std::ifstream jsonl(dir / "out" / "estimates.jsonl");
+    for (std::string l; std::getline(jsonl, l);) checked += l.find("\"tilt_margin\":") != std::string::npos;
+  }
+  const int by_margin = groups["tilt margin < 0.1"] + groups["tilt margin >= 0.1"];
+  EXPECT_GT(by_margin, 0) << r.output;
+  EXPECT_LE(by_margin, std::min(checked, evaluated)) << r.output;
 }
 
 // --two-pass: the recording is tracked again backwards, and each frame of

@@ -82,6 +82,14 @@ struct Estimate {
   std::uint64_t evaluations = 0;      // hypotheses scored for this frame
   bool redetected = false;            // the coarse search's result replaced the tracked one
   bool mirrored = false;              // the tilt mirror of the result scored lower and replaced it
+  // How sure the tilt's sign is: at the mirror check ([tracker]
+  // mirror_check, a result tilted more than 3 deg), the costs of the result
+  // and of its refined tilt mirror, the higher less the lower over the lower.
+  // Seen along the optical axis the two branches differ only through
+  // perspective and occlusion: a small margin is a tilt whose sign the image
+  // barely decides. Empty when the check did not run (a flat gripper, whose
+  // mirror is itself) or the frame is lost.
+  std::optional<double> tilt_margin;
   // Fingers (1 = q1) the image did not see, whose joints are reported at
   // the seen fingers' mean fold ([tracker] unseen_joint_tolerance).
   std::vector<int> unseen_fingers;

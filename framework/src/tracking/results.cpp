@@ -169,6 +169,7 @@ std::string estimate_json(const Estimate& e) {
        ",\"overlap_pixels\":" + std::to_string(e.terms.overlap) + ",\"rim_pixels\":" + std::to_string(e.terms.rim) +
        ",\"redetected\":" +
        (e.redetected ? "true" : "false") + ",\"mirrored\":" + (e.mirrored ? "true" : "false");
+  if (e.tilt_margin) j += ",\"tilt_margin\":" + num(*e.tilt_margin, "%.4f");
   j += ",\"unseen_fingers\":[";
   for (std::size_t k = 0; k < e.unseen_fingers.size(); ++k) j += (k ? "," : "") + std::to_string(e.unseen_fingers[k]);
   j += "]";

@@ -378,6 +378,8 @@ struct Tracker::Impl {
         const PsoResult m = optimise_with(small, mirror, stimulus_on, rng);
         logger().debug("frame {}: mirror check: result {:.4f}, its tilt mirror refined {:.4f}", index, terms.total,
                        m.best_cost);
+        const double kept = std::min(terms.total, m.best_cost), other = std::max(terms.total, m.best_cost);
+        e.tilt_margin = (other - kept) / std::max(kept, 1e-9);
         if (m.best_cost < terms.total) {
           // Reported as mirrored only when the tilt did change branch.
           e.mirrored = m.best[3] * best[3] + m.best[4] * best[4] < 0;
@@ -426,6 +428,7 @@ struct Tracker::Impl {
         e.hypothesis = reported ? *reported : *last;
         e.unseen_fingers.clear();
         e.redetected = e.mirrored = false;
+        e.tilt_margin.reset();
         e.terms = cost->evaluate_one(e.hypothesis);
       } else {
         lost = 0;
