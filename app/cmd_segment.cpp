@@ -85,9 +85,14 @@ int run_segment(const gtrack::cli::CommonOptions& common, const po::variables_ma
   if (fs::exists(out, ec) && !fs::is_directory(out, ec)) {
     throw gtrack::InputError(out.string() + ": is a file; expected a folder (--out)");
   }
-  if (!fs::exists(out, ec)) gtrack::cli::check_output_folder(out, "out");  // its parent must exist
-  fs::create_directories(out / "masks");
-  fs::create_directories(out / "preview");
+  // Made, with its parents, as track's --out is.
+  for (const char* sub : {"masks", "preview"}) {
+    fs::create_directories(out / sub, ec);
+    if (ec || !fs::is_directory(out / sub)) {
+      throw gtrack::InputError((out / sub).string() + ": cannot create the output folder (" +
+                               (ec ? ec.message() : std::string("not a folder")) + ") (--out)");
+    }
+  }
 
   const std::string input = vm["input"].as<std::string>();
   const gtrack::FrameRange range = gtrack::cli::frame_range_option(vm);

@@ -1,5 +1,6 @@
 // gtrack synth: a synthetic sequence with ground truth (paper Section 5.1).
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 #include <iomanip>
 #include <iostream>
@@ -48,6 +49,13 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (vm.count("stimulus-column")) {
     if (!o.stimulus_log) throw gtrack::cli::UsageError("--stimulus-column needs --stimulus");
     o.stimulus_column = vm["stimulus-column"].as<std::string>();
+  }
+  if (vm.count("stimulus-offset")) {
+    if (!o.stimulus_log) throw gtrack::cli::UsageError("--stimulus-offset needs --stimulus");
+    o.stimulus_offset_s = vm["stimulus-offset"].as<double>();
+    if (!std::isfinite(o.stimulus_offset_s)) {
+      throw gtrack::cli::UsageError("--stimulus-offset: expected a finite number of seconds");
+    }
   }
   if (o.threads < 0) throw gtrack::cli::UsageError("--threads must be 0 (all cores) or more");
   if (o.frames < 1) throw gtrack::cli::UsageError("--frames must be at least 1");
@@ -171,6 +179,9 @@ GTRACK_COMMAND(
           "stimulus", po::value<std::string>(),
           "a lab's stimulus log (frame,value or time_s,value) that drives the material instead of the preset's "
           "profile")(
-          "stimulus-column", po::value<std::string>(), "of a log with several named columns, the readings' one");
+          "stimulus-column", po::value<std::string>(), "of a log with several named columns, the readings' one")(
+          "stimulus-offset", po::value<double>(),
+          "SECONDS: a time_s log on another clock: its time at the sequence's first frame, subtracted from its "
+          "times");
     },
     run_synth)

@@ -208,7 +208,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   // No frame to track (said as a warning): the folder was left as it was.
   if (s.frames == 0 && s.renderer.empty() && !s.cancelled) return 0;
   std::FILE* report = stream ? stderr : stdout;
-  char cost[32] = "n/a (no frame found)";
+  char cost[32] = "n/a (no frame tracked)";
   if (std::isfinite(s.mean_cost)) std::snprintf(cost, sizeof cost, "%.4f", s.mean_cost);
   std::fprintf(report, "%d frames (%d lost), mean cost %s, %.1f ms/frame (segment %.1f, pso %.1f, io %.1f), %s renderer -> %s\n",
               s.frames, s.lost_frames, cost, s.mean_ms, s.mean_times.segment_ms, s.mean_times.pso_ms,

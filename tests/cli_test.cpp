@@ -484,6 +484,12 @@ TEST(Cli, RestartFromATableOfAnotherGripperIsOneLine) {
   const CliRun s =
       gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out2").string() + " --score-truth " + table.string());
   expect_refusal(s, table.string() + ": has 2 joint columns, the gripper of this config has 6");
+  // A table that is not there names its option.
+  const std::string none = (dir / "none.csv").string();
+  expect_refusal(gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out3").string() + " --restart-from " + none),
+                 none + ": no such file (--restart-from)");
+  expect_refusal(gtrack(track_of(dir) + " --no-overlay -o " + (dir / "out4").string() + " --score-truth " + none),
+                 none + ": no such file (--score-truth)");
 }
 
 int count_files(const fs::path& dir, const std::string& extension) {
@@ -1369,8 +1375,9 @@ TEST(Cli, SegmentShowsWhatTheBoundsTakeInWholeFrames) {
   EXPECT_NE(r.output.find("saturation:  p1"), std::string::npos) << r.output;
   std::ofstream(dir / "blue.toml") << read_file(dir / "sequence.toml") + "\n[observation]\nhue_min = 100\nhue_max = 130\n";
   const CliRun blue = gtrack("segment -c " + (dir / "blue.toml").string() + " -i " + (dir / "frames").string() +
-                             " -o " + (dir / "seg_blue").string() + " --frames 0");
-  ASSERT_EQ(blue.code, 0) << blue.output;
+                             " -o " + (dir / "seg_blue" / "nested").string() + "/ --frames 0");
+  ASSERT_EQ(blue.code, 0) << blue.output;  // a folder made with its parents, given with a trailing slash
+  EXPECT_TRUE(fs::exists(dir / "seg_blue" / "nested" / "masks" / "000000.png"));
   EXPECT_NE(blue.output.find("frame 0: 0 pixels within the bounds"), std::string::npos) << blue.output;
   EXPECT_EQ(blue.output.find("frame 1:"), std::string::npos) << blue.output;
   std::ofstream(dir / "a_file") << "x";

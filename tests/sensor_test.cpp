@@ -218,6 +218,23 @@ TEST(PinholeMicroscope, BadCalibrationFilesAreOneLineNamingFileAndKey) {
   expect_error(write("nomatrix.yml", "%YAML:1.0\n---\nimage_width: 640\n"), "no camera matrix");
   expect_error(write("short.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400]\n"),
                "'camera_matrix' has 5 values; expected a 3x3 matrix");
+  // A matrix's rows and cols must hold its values, and be 3x3 and one row
+  // or column (OpenCV refuses such a file when it reads it as a matrix).
+  const std::string ros_k = "camera_matrix:\n  rows: 2\n  cols: 3\n  data: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n";
+  expect_error(write("rows.yaml", "image_width: 640\nimage_height: 480\n" + ros_k),
+               "rows.yaml: 'camera_matrix' is 2x3 (rows, cols) but holds 9 values");
+  expect_error(write("k9x1.yaml", "camera_matrix:\n  rows: 9\n  cols: 1\n  data: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"),
+               "'camera_matrix' is 9x1; expected a 3x3 matrix");
+  const std::string k = "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n"
+                        "  data: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n";
+  expect_error(write("dcols.yml", "%YAML:1.0\n---\n" + k +
+                                      "distortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 4\n  dt: d\n"
+                                      "  data: [0.1, 0, 0, 0, 0]\n"),
+               "'distortion_coefficients' is 1x4 (rows, cols) but holds 5 values");
+  expect_error(write("d2x2.yml", "%YAML:1.0\n---\n" + k +
+                                     "distortion_coefficients: !!opencv-matrix\n  rows: 2\n  cols: 2\n  dt: d\n"
+                                     "  data: [0.1, 0, 0, 0]\n"),
+               "'distortion_coefficients' is 2x2; expected one row or one column of coefficients");
   expect_error(write("skew.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 3, 320, 0, 6400, 240, 0, 0, 1]\n"),
                "has a skew");
   expect_error(write("fisheye.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"

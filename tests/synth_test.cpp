@@ -157,7 +157,6 @@ TEST(Synth, ALabsStimulusLogDrivesTheMaterial) {
   o.stimulus_log = log;
   o.stimulus_column = "T_C";
   const auto lab = gtrack::plan_sequence(setup, o);
-  fs::remove(log);
   for (int i = 0; i < o.frames; ++i) {
     const double t = i / 30.0;
     EXPECT_DOUBLE_EQ(lab.frames[i].stimulus, t <= 1 ? 22.0 : t <= 2 ? 22 + 10 * (t - 1) : 32.0) << "frame " << i;
@@ -165,6 +164,25 @@ TEST(Synth, ALabsStimulusLogDrivesTheMaterial) {
   }
   EXPECT_LT(lab.frames[25].truth[gtrack::kPoseDims], 1.0);   // still cold: unfolded
   EXPECT_GT(lab.frames[89].truth[gtrack::kPoseDims], 20.0);  // heated: folding
+  // The same log on a logger's clock that started 100 s before the camera:
+  // none of its rows falls within the frames, which would all take its
+  // first reading, so it is refused; with its time at the first frame
+  // (--stimulus-offset) it drives the material as before.
+  std::ofstream(log) << "time_s,T_C,humidity\n100,22,40\n101,22,40\n102,32,41\n";
+  try {
+    gtrack::plan_sequence(setup, o);
+    ADD_FAILURE() << "a log after the frames was taken";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(log.string() + ": its rows cover t = 100.000 to 102.000 s, and none of the "
+                                         "90 frames to draw (t = 0.000 to 2.967 s) falls within them; expected "
+                                         "seconds from the sequence's first frame"),
+              std::string::npos)
+        << e.what();
+  }
+  o.stimulus_offset_s = 100;
+  const auto shifted = gtrack::plan_sequence(setup, o);
+  fs::remove(log);
+  for (int i = 0; i < o.frames; ++i) EXPECT_DOUBLE_EQ(shifted.frames[i].stimulus, lab.frames[i].stimulus) << i;
 }
 
 TEST(Synth, OcclusionScaleShrinksTheOccludersAndKeepsTheRest) {

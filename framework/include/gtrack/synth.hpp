@@ -97,10 +97,14 @@ struct SynthOptions {
   // A lab's own stimulus log (StimulusLog: frame- or time-keyed, its
   // `stimulus_column` of several) drives the material in place of the
   // preset's profile: each frame takes the log's reading at its time (the
-  // nearest row's past the log's ends). The rest of the seed's sequence
-  // (motion, occluders, look) stays the same.
+  // nearest row's past the log's ends, warned about). A log none of whose
+  // rows falls within the frames is refused. The rest of the seed's
+  // sequence (motion, occluders, look) stays the same.
   std::optional<std::filesystem::path> stimulus_log;
   std::string stimulus_column;
+  // A time_s log on another clock: its time at the first frame
+  // (StimulusLog::shift_time; --stimulus-offset, as for tracking).
+  double stimulus_offset_s = 0;
 };
 
 struct OccluderPlan {

@@ -18,6 +18,7 @@
 
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
+#include "gtrack/log.hpp"
 #include "gtrack/model.hpp"
 #include "gtrack/stimulus_log.hpp"
 #include "gtrack/synth.hpp"
@@ -130,6 +131,38 @@ void apply_synth_table(SynthPreset& p, const ConfigTable& t) {
   }
 }
 
+// A lab's log against the frames to draw: one none of whose rows falls
+// within them is refused (every frame would take its first or last
+// reading), one that covers only some is warned about once. A time within
+// half a frame of the log's ends is the frame's own row, written with few
+// decimals.
+void check_log_covers(const StimulusLog& log, const std::vector<double>& times) {
+  const bool by_time = log.key() == StimulusLog::Key::Time;
+  const int n = static_cast<int>(times.size());
+  const double slack = by_time && n > 1 ? 0.5 * (times[1] - times[0]) : 0;
+  const auto key = [&](int i) { return by_time ? times[static_cast<size_t>(i)] : static_cast<double>(i); };
+  int outside = 0;
+  for (int i = 0; i < n; ++i) outside += key(i) < log.first_key() - slack || key(i) > log.last_key() + slack;
+  if (outside == 0) return;
+  const std::string shifted =
+      log.time_shift() != 0 ? fmt::format(" (its time_s less --stimulus-offset {})", log.time_shift()) : "";
+  const std::string rows = by_time ? fmt::format("t = {:.3f} to {:.3f} s{}", log.first_key(), log.last_key(), shifted)
+                                   : fmt::format("frames {:g} to {:g}", log.first_key(), log.last_key());
+  const std::string frames = by_time ? fmt::format("t = {:.3f} to {:.3f} s", times.front(), times.back())
+                                     : fmt::format("frames 0 to {}", n - 1);
+  if (outside == n) {
+    throw InputError(fmt::format(
+        "{}: its rows cover {}, and none of the {} frames to draw ({}) falls within them; expected {}", log.source(),
+        rows, n, frames,
+        by_time ? "seconds from the sequence's first frame (a logger started before the camera: --stimulus-offset "
+                  "with the log's time at the first frame)"
+                : "frame indices from 0"));
+  }
+  logger().warn("{}: {} of the {} frames to draw ({}) are outside its rows, which cover {}; they take its nearest "
+                "reading",
+                log.source(), outside, n, frames, rows);
+}
+
 }  // namespace
 
 SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
@@ -180,7 +213,9 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   std::optional<StimulusLog> lab_log;
   if (options.stimulus_log) {
     lab_log = StimulusLog::load(*options.stimulus_log, {}, options.stimulus_column);
+    if (options.stimulus_offset_s != 0) lab_log->shift_time(options.stimulus_offset_s);
     for (int i = 0; i < n; ++i) temperature[i] = lab_log->value_at(i, times[i]).value_or(lab_log->nearest(i, times[i]));
+    check_log_covers(*lab_log, times);
   }
   auto occluders = plan_occlusions(p, n, fps, rng);
   for (OccluderPlan& o : occluders) {

@@ -269,6 +269,12 @@ void check_log_unit(const StimulusLog& log, const Stimulus& stimulus, const std:
 // `truth`: every cell must be finite (--score-truth); a track to restart
 // from may hold lost rows, which are refused where they would be used.
 PoseTable read_gripper_poses(const fs::path& file, const Setup& setup, bool truth) {
+  std::error_code ec;
+  const bool folder = fs::is_directory(file, ec);
+  if (folder || !fs::exists(file, ec)) {
+    throw InputError(file.string() + (folder ? ": is a folder; expected a pose table" : ": no such file") + " (" +
+                     (truth ? "--score-truth" : "--restart-from") + ")");
+  }
   PoseTable table = truth ? read_truth_table(file) : read_pose_table(file);
   if (table.fingers != setup.model().fingers()) {
     throw InputError(file.string() + ": has " + std::to_string(table.fingers) +

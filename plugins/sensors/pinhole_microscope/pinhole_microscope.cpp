@@ -118,6 +118,23 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     }
     return {"", cv::FileNode()};
   };
+  // A matrix's declared shape (OpenCV's and ROS's "rows" and "cols"), when
+  // it has one; its values must fill it.
+  const auto shape = [&](const std::pair<std::string, cv::FileNode>& entry,
+                         std::size_t values) -> std::optional<std::pair<int, int>> {
+    const cv::FileNode& node = entry.second;
+    if (!node.isMap() || (node["rows"].empty() && node["cols"].empty())) return std::nullopt;
+    const cv::FileNode r = node["rows"], c = node["cols"];
+    if (!r.isInt() || !c.isInt() || static_cast<int>(r) < 1 || static_cast<int>(c) < 1) {
+      t.fail(key, name + ": '" + entry.first + "' has no positive integer 'rows' and 'cols'");
+    }
+    const int rows = static_cast<int>(r), cols = static_cast<int>(c);
+    if (static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols) != values) {
+      t.fail(key, name + ": '" + entry.first + "' is " + std::to_string(rows) + "x" + std::to_string(cols) +
+                      " (rows, cols) but holds " + std::to_string(values) + " values");
+    }
+    return std::make_pair(rows, cols);
+  };
   const auto numbers = [&](const std::pair<std::string, cv::FileNode>& entry) {
     const auto v = numbers_of(entry.second);
     if (!v) t.fail(key, name + ": '" + entry.first + "' is not a list or matrix of numbers");
@@ -132,8 +149,12 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     t.fail(key, name + ": no camera matrix; expected 'camera_matrix' (OpenCV, ROS) or 'cameraMatrix'");
   }
   const std::vector<double> k = numbers(camera);
-  if (k.size() != 9) {
-    t.fail(key, name + ": '" + camera.first + "' has " + std::to_string(k.size()) + " values; expected a 3x3 matrix");
+  const auto k_shape = shape(camera, k.size());
+  if (k.size() != 9 || (k_shape && k_shape->first != 3)) {
+    t.fail(key, name + ": '" + camera.first + "' " +
+                    (k_shape ? "is " + std::to_string(k_shape->first) + "x" + std::to_string(k_shape->second)
+                             : "has " + std::to_string(k.size()) + " values") +
+                    "; expected a 3x3 matrix");
   }
   c.fx = k[0];
   c.cx = k[2];
@@ -169,6 +190,10 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
   }
   if (!dist.first.empty()) {
     std::vector<double> d = numbers(dist);
+    if (const auto d_shape = shape(dist, d.size()); d_shape && d_shape->first != 1 && d_shape->second != 1) {
+      t.fail(key, name + ": '" + dist.first + "' is " + std::to_string(d_shape->first) + "x" +
+                      std::to_string(d_shape->second) + "; expected one row or one column of coefficients");
+    }
     for (const double x : d) {
       if (std::abs(x) > 1000) t.fail(key, name + ": '" + dist.first + "' holds a coefficient beyond +-1000");
     }
