@@ -151,7 +151,6 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
     if (opt.input.rfind("camera:", 0) == 0) {
       throw gtrack::cli::UsageError("--two-pass needs a recording, not a live camera");
     }
-    if (opt.resume) throw gtrack::cli::UsageError("--two-pass cannot be combined with --resume");
     if (opt.follow_input_s > 0 || opt.follow_stimulus || opt.newest) {
       throw gtrack::cli::UsageError("--two-pass cannot be combined with --follow-input, --follow-stimulus or --newest");
     }
@@ -184,10 +183,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
 
   const gtrack::TrackSummary s = gtrack::track_sequence(setup, config, opt);
   ::alarm(0);
-  // A two-pass run cannot be resumed: its backward pass needs the whole forward run.
-  const char* next = two_pass ? " (the same command with --resume instead of --two-pass continues the forward run)"
-                     : opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
-                                           : " (the same command with --resume continues)";
+  const char* next = opt.follow_stimulus ? " (a run that follows its stimulus log cannot be resumed)"
+                                         : " (the same command with --resume continues)";
   // Why the stream stopped the run ("" when it did not).
   std::string stream_stop;
   if (g_stream_errno != 0) {
@@ -226,6 +223,9 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (s.cancelled && g_stream_errno != 0) return 1;
   if (s.cancelled) return g_reader_gone ? 141 : 130;  // 141: as a process ended by SIGPIPE
   if (two_pass) {
+    // A resumed forward run: the frames of its earlier part are read back
+    // from its estimates (the backward pass needs the whole run).
+    if (opt.resume) forward = gtrack::read_estimates(opt.out_dir, setup.model().fingers());
     const gtrack::TwoPassSummary t = gtrack::two_pass(setup, config, opt, forward);
     if (t.cancelled) {
       // The summary says the run was interrupted, as the exit status does.
@@ -234,7 +234,8 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
       gtrack::write_summary(opt.out_dir / "summary.json", interrupted);
       std::cerr << "gtrack track: interrupted after the forward run (kept in " << opt.out_dir.string()
                 << "); the backward track's finished frames are in " << (opt.out_dir / "backward").string()
-                << ", no two-pass table was written\n";
+                << ", no two-pass table was written (the same command with --resume makes it, the forward run "
+                   "kept)\n";
       return 130;
     }
     std::fprintf(report, "two-pass: %d frames, %d taken from the backward pass (%d lost there), %s, %.1f s -> %s\n",

@@ -1053,8 +1053,24 @@ TEST(Cli, TwoPassTakesEachFrameFromTheForwardOrTheBackwardTrack) {
   EXPECT_GT(inplane_mm(forward[1]), 0.1) << "the forward run was meant to start off";
   EXPECT_LT(inplane_mm(both[1]), 0.03);
 
+  // The same command with --resume after the run is done tracks nothing
+  // more and makes the same table from the forward rows read back.
+  const CliRun again = gtrack("track -c " + (dir / "started_off.toml").string() + " -i " + (dir / "frames").string() +
+                              " -s " + (dir / "stimulus.csv").string() + " --no-overlay --two-pass --resume -o " +
+                              (dir / "out").string());
+  ASSERT_EQ(again.code, 0) << again.output;
+  EXPECT_NE(again.output.find("0 frames (0 lost)"), std::string::npos) << again.output;
+  const auto both_again = read_csv(dir / "out" / "two_pass" / "estimates.csv");
+  ASSERT_EQ(both_again.size(), both.size());
+  for (size_t i = 0; i < both.size(); ++i) {
+    EXPECT_EQ(std::vector<std::string>(both_again[i].begin(), both_again[i].end() - 1),
+              std::vector<std::string>(both[i].begin(), both[i].end() - 1))  // less ms
+        << "row " << i;
+  }
+
   // What cannot be gone back over is refused in one line, before any file is written.
-  for (const std::string& args : {std::string(" --resume"), std::string(" --follow-input 1")}) {
+  for (const std::string& args :
+       {std::string(" --restart-from ") + (dir / "ground_truth.csv").string(), std::string(" --follow-input 1")}) {
     const CliRun refused = gtrack(track_of(dir) + " --two-pass -o " + (dir / "refused").string() + args);
     EXPECT_EQ(refused.code, 2);
     EXPECT_EQ(lines(refused.output), 1) << refused.output;

@@ -37,6 +37,7 @@
 #include "gtrack/engine_config.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "gtrack/two_pass.hpp"
 #include "support/logged.hpp"
 #include "gtrack/setup.hpp"
 #include "gtrack/text_file.hpp"
@@ -1085,6 +1086,80 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
   r = load();
   const std::string log = gtrack::testing::logged([&] { gtrack::track_sequence(r.setup, r.config, second); });
   EXPECT_NE(log.find("overlay.mp4: cannot be read (not closed by the run that wrote it"), std::string::npos) << log;
+}
+
+// --two-pass --resume: a two-pass run interrupted in its forward run is
+// resumed, its earlier frames read back from estimates.jsonl for the
+// backward pass, and gives the two-pass table of a run never interrupted.
+// The read-back rows are the estimates as written.
+TEST(Fault, ResumedTwoPassRunMakesTheTableOfAnUninterruptedOne) {
+  const fs::path dir = fresh_dir("resume_two_pass");
+  const CliRun synth = gtrack_cli("synth --frames 12 --seed 3 --out " + (dir / "seq").string());
+  ASSERT_EQ(synth.code, 0) << synth.output;
+  const std::string config = read_text(dir / "seq" / "sequence.toml") + "[render]\nbackend = \"cpu\"\n";
+  const auto load = [&] {
+    TrackRun r{gtrack::load_setup(gtrack::ConfigTable::parse(config, "sequence.toml"), {}), {}};
+    r.config = gtrack::engine_config(r.setup);
+    return r;
+  };
+  const auto options = [&](const fs::path& out) {
+    gtrack::TrackOptions o;
+    o.input = (dir / "seq" / "frames").string();
+    o.stimulus_csv = dir / "seq" / "stimulus.csv";
+    o.out_dir = out;
+    o.overlay = false;
+    o.progress = false;
+    o.feed_untracked_readings = false;  // as gtrack track --two-pass sets it
+    return o;
+  };
+  std::vector<gtrack::Estimate> forward;
+  {
+    TrackRun r = load();
+    gtrack::TrackOptions o = options(dir / "whole");
+    o.on_frame = [&](const gtrack::Estimate& e) { forward.push_back(e); };
+    gtrack::track_sequence(r.setup, r.config, o);
+    gtrack::two_pass(r.setup, r.config, o, forward);
+  }
+  ASSERT_EQ(forward.size(), 12u);
+  // What is read back is what was made, at the files' precision.
+  const auto read_back = gtrack::read_estimates(dir / "whole", 6);
+  ASSERT_EQ(read_back.size(), forward.size());
+  for (size_t i = 0; i < forward.size(); ++i) {
+    EXPECT_EQ(read_back[i].frame, forward[i].frame);
+    EXPECT_NEAR(read_back[i].time_s, forward[i].time_s, 1e-6);
+    EXPECT_EQ(gtrack::pose_text(read_back[i].hypothesis), gtrack::pose_text(forward[i].hypothesis)) << i;
+    EXPECT_EQ(read_back[i].status, forward[i].status) << i;
+    ASSERT_TRUE(read_back[i].stimulus.has_value());
+    EXPECT_NEAR(*read_back[i].stimulus, *forward[i].stimulus, 1e-6 * std::abs(*forward[i].stimulus)) << i;
+  }
+
+  std::atomic<bool> stop{false};
+  gtrack::TrackOptions first = options(dir / "out");
+  first.cancel = &stop;
+  int n = 0;
+  first.on_frame = [&](const gtrack::Estimate&) { stop = ++n == 5; };
+  TrackRun r = load();
+  EXPECT_TRUE(gtrack::track_sequence(r.setup, r.config, first).cancelled);
+  gtrack::TrackOptions second = options(dir / "out");
+  second.resume = true;
+  r = load();
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, second).frames, 7);
+  const auto parts = gtrack::read_estimates(dir / "out", 6);
+  ASSERT_EQ(parts.size(), 12u);
+  const std::string log = gtrack::testing::logged([&] { gtrack::two_pass(r.setup, r.config, second, parts); });
+  EXPECT_EQ(log.find("gave other estimates"), std::string::npos) << log;
+  EXPECT_EQ(rows_without_time(dir / "out" / "two_pass" / "estimates.csv"),
+            rows_without_time(dir / "whole" / "two_pass" / "estimates.csv"));
+  EXPECT_EQ(rows_without_time(dir / "out" / "backward" / "estimates.csv"),
+            rows_without_time(dir / "whole" / "backward" / "estimates.csv"));
+  // A row that is not gtrack's is one line naming the file and line.
+  std::ofstream(dir / "out" / "estimates.jsonl", std::ios::app) << "{\"frame\":12,\"time_s\":0.4}\n";
+  try {
+    gtrack::read_estimates(dir / "out", 6);
+    ADD_FAILURE() << "a row without its configuration was read";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("estimates.jsonl:13: no 'x_mm'"), std::string::npos) << e.what();
+  }
 }
 
 // --frames A:B starts at A with what the log said before it: a gripper

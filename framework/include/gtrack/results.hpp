@@ -60,6 +60,20 @@ GTRACK_API std::string json_string(const std::string& text);
 // One line of estimates.jsonl (without its newline).
 GTRACK_API std::string estimate_json(const Estimate& estimate);
 
+// A configuration as estimates.csv and estimates.jsonl write it: x, y, z
+// to 1e-6 mm, angles to 1e-4 deg, comma-separated ("null" for a value
+// that is not finite). Two estimates that give the same text are the same
+// estimate in the files.
+GTRACK_API std::string pose_text(const Eigen::VectorXd& h);
+
+// The estimates of a run as its estimates.jsonl holds them: frame, time_s,
+// configuration (NaN for null), status and stimulus reading, which is what
+// two_pass() takes of a forward run (--two-pass --resume: the forward run
+// done in parts). The other fields are left at their defaults. InputError
+// "file:line: ..." for a line that is not one of gtrack's rows, or a
+// configuration of another gripper.
+GTRACK_API std::vector<Estimate> read_estimates(const std::filesystem::path& out_dir, int fingers);
+
 GTRACK_API void write_summary(const std::filesystem::path& file, const TrackSummary& summary);
 
 // Removes the frame images (NNNNNN.png) in dir, as gtrack writes them for

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -18,6 +19,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "gtrack/parameter_space.hpp"
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/text_file.hpp"
 #include "replace_file.hpp"
@@ -131,10 +133,14 @@ ResultWriter::ResultWriter(const fs::path& out_dir, int fingers, bool append) : 
   if (!csv_) throw InputError((out_dir / "estimates.csv").string() + ": write failed (" + write_failure_reason() + ")");
 }
 
+std::string pose_text(const Eigen::VectorXd& h) {
+  std::string text;
+  for (Eigen::Index i = 0; i < h.size(); ++i) text += (i ? "," : "") + num(h[i], i < 3 ? "%.6f" : "%.4f");
+  return text;
+}
+
 void ResultWriter::write(const Estimate& e) {
-  const Eigen::VectorXd& h = e.hypothesis;
-  std::string row = std::to_string(e.frame);
-  for (Eigen::Index i = 0; i < h.size(); ++i) row += "," + num(h[i], i < 3 ? "%.6f" : "%.4f");
+  std::string row = std::to_string(e.frame) + "," + pose_text(e.hypothesis);
   row += "," + num(e.terms.total, "%.6f") + "," + to_string(e.status) + "," + num(e.time_s, "%.6f") + "," +
          num(e.ms, "%.3f") + "\n";
   csv_ << row;
@@ -192,6 +198,65 @@ std::string estimate_json(const Estimate& e) {
   j += ",\"segment_ms\":" + num(e.times.segment_ms, "%.3f") + ",\"pso_ms\":" + num(e.times.pso_ms, "%.3f") +
        ",\"io_ms\":" + num(e.times.io_ms, "%.3f") + "}";
   return j;
+}
+
+std::vector<Estimate> read_estimates(const fs::path& out_dir, int fingers) {
+  const fs::path file = out_dir / "estimates.jsonl";
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot open");
+  std::vector<Estimate> out;
+  std::string line;
+  for (int n = 1; read_bounded_line(in, line, 1 << 20, file.string(), n, "estimates.jsonl's JSON lines"); ++n) {
+    if (line.empty()) continue;
+    const std::string where = file.string() + ":" + std::to_string(n) + ": ";
+    // A key of the row's own (a --score-truth "reference" object comes after them).
+    const std::string own = line.substr(0, line.find(",\"reference\":{"));
+    const auto value_at = [&](const std::string& key) -> std::optional<std::string_view> {
+      const auto at = own.find("\"" + key + "\":");
+      if (at == std::string::npos) return std::nullopt;
+      return std::string_view(own).substr(at + key.size() + 3);
+    };
+    const auto number = [&](const std::string& key, bool may_be_null) {
+      const auto v = value_at(key);
+      if (!v) throw InputError(where + "no '" + key + "'; expected a row of gtrack's estimates.jsonl");
+      if (may_be_null && v->substr(0, 4) == "null") return std::numeric_limits<double>::quiet_NaN();
+      const std::string text(v->substr(0, v->find_first_of(",}")));
+      char* end = nullptr;
+      const double x = std::strtod(text.c_str(), &end);
+      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x)) {
+        throw InputError(where + "'" + key + "' is '" + text + "'; expected a number");
+      }
+      return x;
+    };
+    Estimate e;
+    const double frame = number("frame", false);
+    if (frame < 0 || frame > std::numeric_limits<int>::max() || frame != std::floor(frame)) {
+      throw InputError(where + "'frame' is not a frame index");
+    }
+    e.frame = static_cast<int>(frame);
+    if (!out.empty() && e.frame <= out.back().frame) {
+      throw InputError(where + "frame " + std::to_string(e.frame) + " after frame " + std::to_string(out.back().frame) +
+                       "; expected the frames in increasing order");
+    }
+    e.time_s = number("time_s", false);
+    e.hypothesis.resize(kPoseDims + fingers);
+    for (int i = 0; i < kPoseDims + fingers; ++i) e.hypothesis[i] = number(parameter_name(i), true);
+    if (value_at(parameter_name(kPoseDims + fingers))) {
+      throw InputError(where + "has a joint '" + parameter_name(kPoseDims + fingers) + "'; expected a gripper of " +
+                       std::to_string(fingers) + " fingers");
+    }
+    const auto status = value_at("status");
+    const std::string text = status ? std::string(status->substr(0, status->find(',')))
+                                    : std::string();
+    if (text == "\"ok\"") e.status = TrackStatus::Tracked;
+    else if (text == "\"search\"") e.status = TrackStatus::Search;
+    else if (text == "\"lost\"") e.status = TrackStatus::Lost;
+    else throw InputError(where + "'status' is '" + text + "'; expected \"ok\", \"search\" or \"lost\"");
+    const double stimulus = number("stimulus", true);
+    if (std::isfinite(stimulus)) e.stimulus = stimulus;
+    out.push_back(std::move(e));
+  }
+  return out;
 }
 
 void ResultWriter::close() {

@@ -288,7 +288,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     const Estimate& f = forward[k];
     again_estimates[k] = forward_again.process(frame->image, f.frame, f.time_s, f.stimulus);
     const Estimate& e = again_estimates[k];
-    if (e.hypothesis != f.hypothesis) ++differ;
+    if (pose_text(e.hypothesis) != pose_text(f.hypothesis)) ++differ;  // (the forward run may have been read back)
     const Estimate& b = backward[k];
     if (b.status != TrackStatus::Lost) {
       const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis, view);
