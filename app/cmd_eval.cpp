@@ -16,6 +16,7 @@
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
 #include "gtrack/text_file.hpp"
+#include "gtrack/tracker.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/sensor.hpp"
 #include "gtrack/setup.hpp"
@@ -38,10 +39,6 @@ struct FrameScores {
   double allowance = 0;
   std::optional<double> tilt_margin, cost, reference_cost, reference_outside;
 };
-
-// A tilt margin under this is a tilt whose sign the image barely decides
-// (docs/tracker.md, "How sure the tilt's sign is").
-constexpr double kNarrowTiltMargin = 0.1;
 
 // Per frame, from the estimates.jsonl beside the estimates (empty when there
 // is none).
@@ -99,8 +96,8 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
   std::map<std::string, gtrack::ErrorSet> groups;
   const std::vector<std::string> order = {"unoccluded", "< 40 % hidden", ">= 40 % hidden", "partly out of view",
                                           "unoccluded, no allowance", "unoccluded, an allowance left",
-                                          fmt::format("tilt margin < {}", kNarrowTiltMargin),
-                                          fmt::format("tilt margin >= {}", kNarrowTiltMargin)};
+                                          fmt::format("tilt margin < {}", gtrack::kNarrowTiltMargin),
+                                          fmt::format("tilt margin >= {}", gtrack::kNarrowTiltMargin)};
   std::map<std::string, int> other_branch;  // frames on the other branch of the tilt's sign, per group
   // With the truth scored (--score-truth): is the search or the cost short?
   const std::vector<std::string> why = {"truth scores lower", "truth spills over allowance", "truth scores no lower"};
@@ -118,7 +115,7 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     const auto s = scores.find(f.frame);
     if (g == order[0] && s != scores.end()) groups[s->second.allowance > 0 ? order[5] : order[4]].add(f.errors);
     if (s != scores.end() && s->second.tilt_margin) {
-      const std::string& t = *s->second.tilt_margin < kNarrowTiltMargin ? order[6] : order[7];
+      const std::string& t = *s->second.tilt_margin < gtrack::kNarrowTiltMargin ? order[6] : order[7];
       groups[t].add(f.errors);
       other_branch[t] += f.errors.tilt_branch ? 1 : 0;
     }

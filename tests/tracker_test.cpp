@@ -1060,6 +1060,29 @@ TEST(Tracker, TiltMarginIsWideForAFoldedGripperAndNarrowForAFlatOne) {
   if (flat_on) {
     ADD_FAILURE() << "a gripper seen flat-on was checked (margin " << *flat_on << ")";
   }
+  // The overlay says so at its top under a narrow margin only.
+  Eigen::VectorXd h = pose(0.3, -0.2, 20, 0);
+  h[3] = 25;
+  const cv::Mat image = scene(setup, h, 4);
+  gtrack::Tracker tracker(setup, config);
+  gtrack::Estimate e;
+  e.hypothesis = h;
+  const cv::Rect corner(0, 0, image.cols, image.rows / 8);  // the top band
+  const cv::Mat none = tracker.draw_overlay(image, e);
+  e.tilt_margin = 0.5;
+  const cv::Mat wide = tracker.draw_overlay(image, e);
+  e.tilt_margin = 0.05;
+  const cv::Mat narrow = tracker.draw_overlay(image, e);
+  EXPECT_EQ(cv::norm(none(corner), wide(corner), cv::NORM_INF), 0);
+  EXPECT_GT(cv::norm(none(corner), narrow(corner), cv::NORM_L1), 0);
+  cv::Mat diff, changed;
+  cv::absdiff(none, narrow, diff);
+  cv::transform(diff, changed, cv::Matx13f(1, 1, 1));  // summed over the channels
+  std::vector<cv::Point> at;
+  cv::findNonZero(changed, at);
+  ASSERT_FALSE(at.empty());
+  const cv::Rect where = cv::boundingRect(at);
+  EXPECT_EQ(where & corner, where) << where;  // nothing else drawn
 }
 
 // The turned tilt of re-detection's searches: the Euler pair (rx, ry)

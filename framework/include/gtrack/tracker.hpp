@@ -66,6 +66,11 @@ struct StageTimes {
   double io_ms = 0;
 };
 
+// A tilt margin (Estimate::tilt_margin) under this is a tilt whose sign the
+// image barely decides: the overlay says so and gtrack eval --breakdown
+// splits the frames there (docs/tracker.md, "How sure the tilt's sign is").
+inline constexpr double kNarrowTiltMargin = 0.1;
+
 struct Estimate {
   int frame = 0;
   double time_s = 0;
@@ -87,8 +92,8 @@ struct Estimate {
   // and of its refined tilt mirror, the higher less the lower over the lower.
   // Seen along the optical axis the two branches differ only through
   // perspective and occlusion: a small margin is a tilt whose sign the image
-  // barely decides. Empty when the check did not run (a flat gripper, whose
-  // mirror is itself) or the frame is lost.
+  // barely decides (under kNarrowTiltMargin). Empty when the check did not
+  // run (a flat gripper, whose mirror is itself) or the frame is lost.
   std::optional<double> tilt_margin;
   // Fingers (1 = q1) the image did not see, whose joints are reported at
   // the seen fingers' mean fold ([tracker] unseen_joint_tolerance).
@@ -188,7 +193,8 @@ class GTRACK_API Tracker {
   double temporal_term(const Eigen::VectorXd& hypothesis, const Eigen::VectorXd& prediction) const;
   // The estimate drawn on a frame: posed triangles projected with
   // Sensor::project and filled in green with alpha, plus the stimulus reading
-  // in the bottom-right corner.
+  // in the bottom-right corner; "lost", or "tilt's sign uncertain" under a
+  // narrow tilt margin, in the top-left one.
   cv::Mat draw_overlay(const cv::Mat& frame, const Estimate& estimate) const;
 
   // The renderer, config and space the search uses: in the sensor's frame,

@@ -90,6 +90,11 @@ cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const Articula
   if (lost) {
     cv::putText(out, "lost", cv::Point(12, static_cast<int>(30 * font)), cv::FONT_HERSHEY_SIMPLEX, font,
                 cv::Scalar(0, 160, 255), thick, cv::LINE_AA);
+  } else if (estimate.tilt_margin && *estimate.tilt_margin < kNarrowTiltMargin) {
+    // The outline fits either sign of the tilt: the overlay looks right
+    // whichever was taken.
+    cv::putText(out, "tilt's sign uncertain", cv::Point(12, static_cast<int>(30 * font)), cv::FONT_HERSHEY_SIMPLEX,
+                font, cv::Scalar(0, 220, 255), thick, cv::LINE_AA);
   }
   return out;
 }
