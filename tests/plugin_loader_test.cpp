@@ -217,7 +217,11 @@ TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {
            {"nan = \"mm_per_pixel\"", "the sensor plugin's mm_per_pixel() is nan; expected a positive number"},
            {"mm_per_pixel = 0.0", "the sensor plugin's mm_per_pixel() is 0; expected a positive number"},
            {"nan = \"nominal_position\"", "the sensor plugin's nominal_position_mm() is not finite"},
-           {"nan = \"projection\"", "the sensor plugin's projection() holds a world_to_image that is not finite"}}) {
+           {"nan = \"projection\"", "the sensor plugin's projection() holds a world_to_image that is not finite"},
+           // Its calls that throw, and more clip planes than a renderer takes.
+           {"throws = \"projection\"", "the sensor plugin's projection() threw: projection not calibrated"},
+           {"throws = \"project\"", "the sensor plugin's project() threw: no lens model yet"},
+           {"clip_planes = 9", "the sensor plugin's projection() has 9 clip planes; expected at most 8"}}) {
     try {
       gtrack::load_setup(gtrack::ConfigTable::parse(
                              "[sensor]\nplugin = \"fixture_good_sensor\"\n" + key + "\n" + gripper, "lab.toml"),
@@ -227,6 +231,27 @@ TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {
       EXPECT_NE(std::string(e.what()).find("lab.toml:2: key 'sensor.plugin': " + said), std::string::npos)
           << e.what();
     }
+  }
+}
+
+// A gripper plugin whose model() holds nothing (a default-constructed
+// model) is refused when the setup is loaded, naming the plugin's key; it
+// had drawn empty frames and failed later in the renderer.
+TEST(PluginLoader, AGripperWithAnEmptyModelIsRefused) {
+  gtrack::SetupOptions o;
+  o.plugin_paths = {kFixtures};
+  o.with_stimulus = false;
+  try {
+    gtrack::load_setup(gtrack::ConfigTable::parse("[sensor]\nplugin = \"fixture_good_sensor\"\n[gripper]\n"
+                                                  "plugin = \"fixture_empty_gripper\"\n",
+                                                  "lab.toml"),
+                       o);
+    ADD_FAILURE() << "an empty model was taken";
+  } catch (const gtrack::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.toml:4: key 'gripper.plugin': the gripper plugin's model() has no "
+                                         "fingers or no size"),
+              std::string::npos)
+        << e.what();
   }
 }
 

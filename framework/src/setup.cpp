@@ -6,6 +6,7 @@
 
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
+#include "render/clip.hpp"
 #include "tracking/run_config.hpp"
 
 namespace gtrack {
@@ -53,23 +54,42 @@ void warn_on_scale_mismatch(const ConfigTable& root, const Sensor& sensor, const
 // image_size(): a sensor plugin whose two differ (its projection's size left
 // unset) would render nothing the frames show.
 void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
-  // The numbers the engine builds on (the search box, the model's scale):
-  // one that is not finite would surface as a config key the file lacks.
-  const Projection projection = sensor.projection();
   const auto refuse = [&](const std::string& what, const char* expected) {
     table.fail("plugin", "the sensor plugin's " + what + "; expected " + expected);
   };
+  // The numbers the engine builds on (the search box, the model's scale):
+  // one that is not finite would surface as a config key the file lacks.
+  // A call that throws is said as the plugin's, not as the renderer's.
+  const auto call = [&](const char* name, const auto& f) {
+    try {
+      return f();
+    } catch (const std::exception& e) {
+      table.fail("plugin", std::string("the sensor plugin's ") + name + " threw: " + e.what());
+    } catch (...) {
+      table.fail("plugin", std::string("the sensor plugin's ") + name + " threw something that is not a std::exception");
+    }
+  };
+  const Projection projection = call("projection()", [&] { return sensor.projection(); });
+  if (projection.clip_planes.size() > static_cast<size_t>(render::kMaxSensorPlanes)) {
+    refuse(fmt::format("projection() has {} clip planes", projection.clip_planes.size()),
+           fmt::format("at most {}", render::kMaxSensorPlanes).c_str());
+  }
   if (!projection.world_to_image.allFinite()) {
     refuse("projection() holds a world_to_image that is not finite", "finite numbers");
   }
   for (const auto& plane : projection.clip_planes) {
     if (!plane.allFinite()) refuse("projection() holds a clip plane that is not finite", "finite numbers");
   }
-  if (!sensor.nominal_position_mm().allFinite()) refuse("nominal_position_mm() is not finite", "finite numbers");
-  if (const double mm = sensor.mm_per_pixel(); !(std::isfinite(mm) && mm > 0)) {
+  if (!call("nominal_position_mm()", [&] { return sensor.nominal_position_mm(); }).allFinite()) {
+    refuse("nominal_position_mm() is not finite", "finite numbers");
+  }
+  if (const double mm = call("mm_per_pixel()", [&] { return sensor.mm_per_pixel(); }); !(std::isfinite(mm) && mm > 0)) {
     refuse(fmt::format("mm_per_pixel() is {}", mm), "a positive number of millimetres");
   }
-  const ImageSize image = sensor.image_size();
+  // The sensor's centre ray, once: a project() that throws for any point
+  // (a plugin left unfinished) is said here, naming the plugin.
+  call("project()", [&] { return sensor.project(sensor.nominal_position_mm()); });
+  const ImageSize image = call("image_size()", [&] { return sensor.image_size(); });
   const ImageSize drawn = projection.size;
   if (image.width <= 0 || image.height <= 0 || drawn.width != image.width || drawn.height != image.height) {
     table.fail("plugin", "the sensor's projection().size is " + std::to_string(drawn.width) + "x" +
@@ -101,6 +121,11 @@ Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   s.sensor = loader->make_sensor(root.table("sensor"));
   check_projection_size(root.table("sensor"), *s.sensor);
   s.gripper = loader->make_gripper(root.table("gripper"));
+  if (s.model().fingers() < 1 || s.model().dims() != kPoseDims + s.model().fingers() || !(s.model().radius_mm() > 0)) {
+    root.table("gripper").fail("plugin", "the gripper plugin's model() has no fingers or no size; expected a model "
+                                         "built from its geometry (gtrack::ArticulatedModel(geometry), with "
+                                         "gtrack::make_radial_gripper or a geometry of its own)");
+  }
   warn_on_scale_mismatch(root, *s.sensor, s.model());
   if (options.with_stimulus) {
     // No [stimulus]: a gripper whose fold no stimulus drives (or none is
