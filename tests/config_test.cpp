@@ -80,7 +80,14 @@ TEST(Config, HugeTextIsQuotedShort) {
   auto p = gtrack::ConfigTable::parse("[sensor]\nplugin = \"" + std::string(100000, 'A') + "\"\n", "h.toml");
   e = error_of([&] { gtrack::testing::loader().make_sensor(p.table("sensor")); });
   EXPECT_EQ(e, "h.toml:2: key 'sensor.plugin': expected a plugin name (letters, digits, '_' and '-', 1 to 64 "
-               "characters), got a string of 100000 characters");
+               "characters), got '" + std::string(60, 'A') + "... (100000 characters)'");
+  // A plugin's file given for its name.
+  p = gtrack::ConfigTable::parse("[sensor]\nplugin = \"build/libgtrack_lab.so\"\n", "h.toml");
+  e = error_of([&] { gtrack::testing::loader().make_sensor(p.table("sensor")); });
+  EXPECT_NE(e.find("got 'build/libgtrack_lab.so'; a plugin is named without its folder or file name ('light' for "
+                   "libgtrack_light.so)"),
+            std::string::npos)
+      << e;
 }
 
 TEST(Config, UnknownTableAtTopLevel) {

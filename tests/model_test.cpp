@@ -151,3 +151,35 @@ TEST(HydrogelModel, ConfigOverridesAreValidated) {
 }
 
 }  // namespace
+
+// A link whose length or widths are not positive finite numbers is refused
+// naming the finger and the link; a NaN width had passed every comparison.
+TEST(Model, ALinkThatIsNoNumberIsRefusedNamingIt) {
+  const auto geometry = [](double length, double width) {
+    gtrack::GripperGeometry g;
+    g.name = "lab";
+    g.palm_mm = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    gtrack::FingerShape f;
+    f.base_mm = {1, 0};
+    f.links = {{0.5, 0.2, 0.2}, {length, width, 0.1}};
+    g.fingers = {f, f};
+    g.fingers[1].base_mm = {-1, 0};
+    g.fingers[1].direction_deg = 180;
+    return g;
+  };
+  EXPECT_NO_THROW(gtrack::ArticulatedModel(geometry(0.5, 0.2)));
+  const auto error = [](const gtrack::GripperGeometry& g) {
+    try {
+      gtrack::ArticulatedModel m(g);
+    } catch (const gtrack::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error(geometry(std::nan(""), 0.2)),
+            "gripper 'lab': finger 1, link 2: length nan mm; expected a positive finite number");
+  EXPECT_EQ(error(geometry(0.5, std::nan(""))),
+            "gripper 'lab': finger 1, link 2: widths nan and 0.1 mm; expected finite numbers, neither negative nor "
+            "both 0");
+  EXPECT_NE(error(geometry(0.5, -0.1)).find("link 2: widths -0.1 and 0.1 mm"), std::string::npos);
+}

@@ -7,6 +7,8 @@
 #include <limits>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "gtrack/error.hpp"
 
 namespace gtrack {
@@ -244,10 +246,17 @@ ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) 
   if (G.symmetry_order < 1) throw Error("gripper '" + G.name + "': symmetry order must be >= 1");
   for (size_t f = 0; f < G.fingers.size(); ++f) {
     if (G.fingers[f].links.empty()) throw Error("gripper '" + G.name + "': finger " + std::to_string(f + 1) + " has no links");
-    for (const auto& l : G.fingers[f].links) {
-      if (!(l.length_mm > 0) || l.width_start_mm < 0 || l.width_end_mm < 0 || (l.width_start_mm <= 0 && l.width_end_mm <= 0)) {
-        throw Error("gripper '" + G.name + "': finger " + std::to_string(f + 1) +
-                    " has a link with non-positive length or width");
+    for (size_t k = 0; k < G.fingers[f].links.size(); ++k) {
+      const auto& l = G.fingers[f].links[k];
+      const std::string link = "gripper '" + G.name + "': finger " + std::to_string(f + 1) + ", link " +
+                               std::to_string(k + 1) + ": ";
+      if (!(l.length_mm > 0) || !std::isfinite(l.length_mm)) {
+        throw Error(link + "length " + fmt::format("{}", l.length_mm) + " mm; expected a positive finite number");
+      }
+      if (!(l.width_start_mm >= 0) || !(l.width_end_mm >= 0) || !std::isfinite(l.width_start_mm) ||
+          !std::isfinite(l.width_end_mm) || (l.width_start_mm <= 0 && l.width_end_mm <= 0)) {
+        throw Error(link + "widths " + fmt::format("{} and {}", l.width_start_mm, l.width_end_mm) +
+                    " mm; expected finite numbers, neither negative nor both 0");
       }
     }
   }
@@ -438,7 +447,8 @@ std::vector<std::pair<int, int>> ring_adjacency(int fingers) {
 }
 
 GripperGeometry make_radial_gripper(const RadialGripperSpec& s) {
-  if (s.palm_sides < 3 || s.fingers < 1 || s.palm_sides % s.fingers != 0) {
+  if (s.fingers < 1) throw Error("gripper '" + s.name + "': " + std::to_string(s.fingers) + " fingers; expected 1 or more");
+  if (s.palm_sides < 3 || s.palm_sides % s.fingers != 0) {
     throw Error("gripper '" + s.name + "': palm_sides must be >= 3 and a multiple of the number of fingers");
   }
   GripperGeometry g;

@@ -299,7 +299,8 @@ std::shared_ptr<Interface> PluginLoader::make_from_file(const fs::path& file, co
   } catch (const std::exception& e) {
     throw PluginError(plugin_label(kind, name, file) + ": could not be created: " + e.what());
   } catch (...) {
-    throw PluginError(plugin_label(kind, name, file) + ": could not be created: unknown exception");
+    throw PluginError(plugin_label(kind, name, file) +
+                      ": could not be created: its constructor threw something that is not a std::exception");
   }
   if (!raw) {
     throw PluginError(plugin_label(kind, name, file) + ": factory returned nothing");
@@ -335,8 +336,14 @@ std::shared_ptr<Interface> PluginLoader::make(const ConfigTable& table) const {
   }
   const std::string name = table.string("plugin");
   if (!is_plugin_name(name)) {
-    table.fail("plugin", "expected a plugin name (letters, digits, '_' and '-', 1 to 64 characters), got a string of " +
-                             std::to_string(name.size()) + " characters");
+    // A file given for its name: the name is the file's less "libgtrack_"
+    // and ".so", and its folder goes in plugin_path.
+    const bool file = name.find('/') != std::string::npos || name.find(".so") != std::string::npos;
+    table.fail("plugin", "expected a plugin name (letters, digits, '_' and '-', 1 to 64 characters), got '" +
+                             shown(name, 60) + "'" +
+                             (file ? "; a plugin is named without its folder or file name ('light' for "
+                                     "libgtrack_light.so), its folder given in plugin_path or --plugin-path"
+                                   : ""));
   }
   // Where the config names the plugin, ahead of what is wrong with it (not
   // found, not loadable, another kind or ABI, its factory failed).
