@@ -126,7 +126,7 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const std::filesystem::path out = gtrack::cli::out_folder(vm);
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
   std::string unit;
-  if (setup.stimulus && !setup.stimulus->reading_unit().empty()) unit = " " + setup.stimulus->reading_unit();
+  if (setup.stimulus && !setup.stimulus->reading_unit().empty()) unit = fmt::format(" {}", setup.stimulus->reading_unit());
   std::cout << std::fixed << std::setprecision(1) << "synthetic sequence: " << s.frames << " frames (preset "
             << o.preset << ", seed " << o.seed << ") in " << s.seconds << " s -> " << out.string() << "\n"
             << "  occluded frames: " << s.occluded_frames << " (" << 100.0 * s.occluded_frames / s.frames

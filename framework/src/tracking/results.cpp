@@ -224,7 +224,7 @@ std::vector<Estimate> read_estimates(const fs::path& out_dir, int fingers) {
       char* end = nullptr;
       const double x = std::strtod(text.c_str(), &end);
       if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x)) {
-        throw InputError(where + "'" + key + "' is '" + text + "'; expected a number");
+        throw InputError(where + "'" + key + "' is '" + shown(text, 40) + "'; expected a number");
       }
       return x;
     };
@@ -246,12 +246,16 @@ std::vector<Estimate> read_estimates(const fs::path& out_dir, int fingers) {
                        std::to_string(fingers) + " fingers");
     }
     const auto status = value_at("status");
-    const std::string text = status ? std::string(status->substr(0, status->find(',')))
-                                    : std::string();
-    if (text == "\"ok\"") e.status = TrackStatus::Tracked;
-    else if (text == "\"search\"") e.status = TrackStatus::Search;
-    else if (text == "\"lost\"") e.status = TrackStatus::Lost;
-    else throw InputError(where + "'status' is '" + text + "'; expected \"ok\", \"search\" or \"lost\"");
+    const std::string text = status ? std::string(status->substr(0, status->find(','))) : std::string();
+    if (text == "\"ok\"") {
+      e.status = TrackStatus::Tracked;
+    } else if (text == "\"search\"") {
+      e.status = TrackStatus::Search;
+    } else if (text == "\"lost\"") {
+      e.status = TrackStatus::Lost;
+    } else {
+      throw InputError(where + "'status' is '" + shown(text, 40) + "'; expected \"ok\", \"search\" or \"lost\"");
+    }
     const double stimulus = number("stimulus", true);
     if (std::isfinite(stimulus)) e.stimulus = stimulus;
     out.push_back(std::move(e));
