@@ -221,7 +221,10 @@ TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {
            // Its calls that throw, and more clip planes than a renderer takes.
            {"throws = \"projection\"", "the sensor plugin's projection() threw: projection not calibrated"},
            {"throws = \"project\"", "the sensor plugin's project() threw: no lens model yet"},
-           {"clip_planes = 9", "the sensor plugin's projection() has 9 clip planes; expected at most 8"}}) {
+           {"clip_planes = 9", "the sensor plugin's projection() has 9 clip planes; expected at most 8"},
+           {"nan = \"projection_row\"",
+            "the sensor plugin's projection() images the world about nominal_position_mm() onto a line or a point "
+            "(at 1 and 0 pixels per mm in its two directions); expected a world_to_image of rank 3"}}) {
     try {
       gtrack::load_setup(gtrack::ConfigTable::parse(
                              "[sensor]\nplugin = \"fixture_good_sensor\"\n" + key + "\n" + gripper, "lab.toml"),

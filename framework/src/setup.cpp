@@ -1,7 +1,9 @@
 // Loading the three plugins a config names.
 #include "gtrack/setup.hpp"
 
+#include <Eigen/SVD>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "gtrack/error.hpp"
@@ -88,7 +90,36 @@ void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
   }
   // The sensor's centre ray, once: a project() that throws for any point
   // (a plugin left unfinished) is said here, naming the plugin.
-  call("project()", [&] { return sensor.project(sensor.nominal_position_mm()); });
+  const Eigen::Vector3d nominal = sensor.nominal_position_mm();
+  call("project()", [&] { return sensor.project(nominal); });
+  // What the renderers draw: the world about the nominal position must
+  // image in front of the sensor and onto the plane, not onto a line (a
+  // matrix row left zero renders every hypothesis as a line, and every
+  // frame is lost without a word).
+  const Eigen::Matrix<double, 3, 4>& P = projection.world_to_image;
+  const auto image_of = [&](const Eigen::Vector3d& x) -> std::optional<Eigen::Vector2d> {
+    const Eigen::Vector3d h = P * x.homogeneous();
+    if (!(h.z() > 0)) return std::nullopt;
+    return Eigen::Vector2d(h.head<2>() / h.z());
+  };
+  const auto centre = image_of(nominal);
+  if (!centre) {
+    refuse("projection() puts nominal_position_mm() behind the sensor (its world_to_image gives it w <= 0)",
+           "the nominal position in front of it");
+  }
+  Eigen::Matrix<double, 2, 3> J;  // pixels per millimetre about the nominal position
+  const double step = sensor.mm_per_pixel();
+  for (int k = 0; k < 3; ++k) {
+    const auto moved = image_of(nominal + step * Eigen::Vector3d::Unit(k));
+    J.col(k) = moved ? Eigen::Vector2d((*moved - *centre) / step) : Eigen::Vector2d::Zero();
+  }
+  const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix<double, 2, 3>>(J).singularValues();
+  if (!(sv[1] > 1e-3 * sv[0]) || !(sv[0] > 0)) {
+    refuse(fmt::format("projection() images the world about nominal_position_mm() onto a line or a point (at {:.3g} "
+                       "and {:.3g} pixels per mm in its two directions)",
+                       sv[0], sv[1]),
+           "a world_to_image of rank 3 (each image direction its own row)");
+  }
   const ImageSize image = call("image_size()", [&] { return sensor.image_size(); });
   const ImageSize drawn = projection.size;
   if (image.width <= 0 || image.height <= 0 || drawn.width != image.width || drawn.height != image.height) {
