@@ -82,15 +82,12 @@ void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
   for (const auto& plane : projection.clip_planes) {
     if (!plane.allFinite()) refuse("projection() holds a clip plane that is not finite", "finite numbers");
   }
-  if (!call("nominal_position_mm()", [&] { return sensor.nominal_position_mm(); }).allFinite()) {
-    refuse("nominal_position_mm() is not finite", "finite numbers");
-  }
-  if (const double mm = call("mm_per_pixel()", [&] { return sensor.mm_per_pixel(); }); !(std::isfinite(mm) && mm > 0)) {
-    refuse(fmt::format("mm_per_pixel() is {}", mm), "a positive number of millimetres");
-  }
+  const Eigen::Vector3d nominal = call("nominal_position_mm()", [&] { return sensor.nominal_position_mm(); });
+  if (!nominal.allFinite()) refuse("nominal_position_mm() is not finite", "finite numbers");
+  const double mm = call("mm_per_pixel()", [&] { return sensor.mm_per_pixel(); });
+  if (!(std::isfinite(mm) && mm > 0)) refuse(fmt::format("mm_per_pixel() is {}", mm), "a positive number of millimetres");
   // The sensor's centre ray, once: a project() that throws for any point
   // (a plugin left unfinished) is said here, naming the plugin.
-  const Eigen::Vector3d nominal = sensor.nominal_position_mm();
   call("project()", [&] { return sensor.project(nominal); });
   // What the renderers draw: the world about the nominal position must
   // image in front of the sensor and onto the plane, not onto a line (a
@@ -108,10 +105,9 @@ void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
            "the nominal position in front of it");
   }
   Eigen::Matrix<double, 2, 3> J;  // pixels per millimetre about the nominal position
-  const double step = sensor.mm_per_pixel();
-  for (int k = 0; k < 3; ++k) {
-    const auto moved = image_of(nominal + step * Eigen::Vector3d::Unit(k));
-    J.col(k) = moved ? Eigen::Vector2d((*moved - *centre) / step) : Eigen::Vector2d::Zero();
+  for (int k = 0; k < 3; ++k) {  // a pixel's step
+    const auto moved = image_of(nominal + mm * Eigen::Vector3d::Unit(k));
+    J.col(k) = moved ? Eigen::Vector2d((*moved - *centre) / mm) : Eigen::Vector2d::Zero();
   }
   const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix<double, 2, 3>>(J).singularValues();
   if (!(sv[1] > 1e-3 * sv[0]) || !(sv[0] > 0)) {
