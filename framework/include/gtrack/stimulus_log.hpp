@@ -69,6 +69,9 @@ class GTRACK_API StimulusLog {
   // log keyed by frame, or one still followed.
   void shift_time(double seconds);
   double time_shift() const { return shift_s_; }
+  // How a message shows the keys once shift_time() moved them: " (its
+  // time_s less --stimulus-offset S)", else "".
+  std::string shift_note() const;
   // The reading for a frame (index and time); nullopt outside the log.
   std::optional<double> value_at(int frame, double time_s) const;
   // The reading of the nearest row (for frames outside the log); the log

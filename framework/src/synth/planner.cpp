@@ -144,9 +144,8 @@ void check_log_covers(const StimulusLog& log, const std::vector<double>& times) 
   int outside = 0;
   for (int i = 0; i < n; ++i) outside += key(i) < log.first_key() - slack || key(i) > log.last_key() + slack;
   if (outside == 0) return;
-  const std::string shifted =
-      log.time_shift() != 0 ? fmt::format(" (its time_s less --stimulus-offset {})", log.time_shift()) : "";
-  const std::string rows = by_time ? fmt::format("t = {:.3f} to {:.3f} s{}", log.first_key(), log.last_key(), shifted)
+  const std::string rows = by_time ? fmt::format("t = {:.3f} to {:.3f} s{}", log.first_key(), log.last_key(),
+                                                 log.shift_note())
                                    : fmt::format("frames {:g} to {:g}", log.first_key(), log.last_key());
   const std::string frames = by_time ? fmt::format("t = {:.3f} to {:.3f} s", times.front(), times.back())
                                      : fmt::format("frames 0 to {}", n - 1);

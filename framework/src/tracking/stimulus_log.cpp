@@ -9,6 +9,8 @@
 #include <sstream>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "gtrack/error.hpp"
 #include "gtrack/log.hpp"
 #include "gtrack/text_file.hpp"
@@ -271,6 +273,10 @@ bool StimulusLog::poll() {
     latest_at_ = now;
   }
   return keys_.size() > rows_before;
+}
+
+std::string StimulusLog::shift_note() const {
+  return shift_s_ != 0 ? fmt::format(" (its time_s less --stimulus-offset {})", shift_s_) : "";
 }
 
 void StimulusLog::shift_time(double seconds) {

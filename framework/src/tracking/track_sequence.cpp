@@ -173,18 +173,13 @@ int expected_frames(const FrameSource& src, const FrameRange& r) {
   return (n - r.first + r.every - 1) / r.every;
 }
 
-// How a log's times are shown when --stimulus-offset moved them.
-std::string shifted_by(const StimulusLog& log) {
-  return log.time_shift() != 0 ? fmt::format(" (its time_s less --stimulus-offset {})", log.time_shift()) : "";
-}
-
 // A time_s log whose times start more than a day after a frame's: seconds
 // since 1970 (Unix time), say.
 std::string another_clock(const StimulusLog& log, int frame, double time_s) {
   return fmt::format(
       "{}: its times start at t = {:.3f} s{}, more than a day after frame {} (t = {:.3f} s); expected seconds "
       "from the recording's first frame (a log in Unix time: --stimulus-offset with the first frame's time)",
-      log.source(), log.first_key(), shifted_by(log), frame, time_s);
+      log.source(), log.first_key(), log.shift_note(), frame, time_s);
 }
 
 // A finished time_s log against the frames to track: one whose rows all come
@@ -217,7 +212,7 @@ void check_log_covers_frames(const StimulusLog& log, const TrackOptions& options
         "{}: its rows cover t = {:.3f} to {:.3f} s{}, after the frames to track (t = {:.3f} to {:.3f} s): none of "
         "them falls within the log; expected seconds from the recording's first frame (a logger started before "
         "the camera: --stimulus-offset with the log's time at the first frame)",
-        log.source(), log.first_key(), log.last_key(), shifted_by(log), from, to));
+        log.source(), log.first_key(), log.last_key(), log.shift_note(), from, to));
   }
 }
 
@@ -706,7 +701,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
         logger().warn("{}: frame {} (t = {:.3f} s) is outside the stimulus log, whose rows cover {} {:.{}f} to "
                       "{:.{}f}{}; holding its nearest reading",
                       log->source(), index, time_s, by_time ? "t =" : "frames", log->first_key(), by_time ? 3 : 0,
-                      log->last_key(), by_time ? 3 : 0, shifted_by(*log));
+                      log->last_key(), by_time ? 3 : 0, log->shift_note());
         warned_range = true;
       }
       reading = log->nearest(index, time_s);
