@@ -15,6 +15,7 @@
 #include "command.hpp"
 #include "gtrack/error.hpp"
 #include "gtrack/evaluation.hpp"
+#include "gtrack/results.hpp"
 #include "gtrack/text_file.hpp"
 #include "gtrack/tracker.hpp"
 #include "gtrack/log.hpp"
@@ -49,12 +50,12 @@ std::map<int, FrameScores> frame_scores(const fs::path& estimates_csv) {
   std::string line;
   for (int n = 1; gtrack::read_bounded_line(in, line, 1 << 16, file.string(), n, "estimates.jsonl's JSON lines"); ++n) {
     const auto field = [&](const std::string& text, const std::string& key) -> std::optional<double> {
-      const auto at = text.find("\"" + key + "\":");
-      if (at == std::string::npos) return std::nullopt;
+      const auto value = gtrack::json_field(text, key);
+      if (!value) return std::nullopt;
+      const std::string number(*value);
       char* end = nullptr;
-      const char* start = text.c_str() + at + key.size() + 3;
-      const double v = std::strtod(start, &end);
-      return end == start ? std::nullopt : std::optional<double>(v);
+      const double v = std::strtod(number.c_str(), &end);
+      return end == number.c_str() ? std::nullopt : std::optional<double>(v);
     };
     const auto ref_at = line.find("\"reference\":{");
     const std::string own = line.substr(0, ref_at);

@@ -9,7 +9,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gtrack/export.hpp"
@@ -65,6 +67,11 @@ GTRACK_API std::string estimate_json(const Estimate& estimate);
 // that is not finite). Two estimates that give the same text are the same
 // estimate in the files.
 GTRACK_API std::string pose_text(const Eigen::VectorXd& h);
+
+// The text of the value `key` has among a JSON line's fields (`"key":` up
+// to the next ',' or '}'), as estimates.jsonl writes numbers, null, true,
+// false and plain strings; nullopt when there is no such key.
+GTRACK_API std::optional<std::string_view> json_field(std::string_view text, std::string_view key);
 
 // The estimates of a run as its estimates.jsonl holds them: frame, time_s,
 // configuration (NaN for null), status and stimulus reading, which is what

@@ -200,6 +200,14 @@ std::string estimate_json(const Estimate& e) {
   return j;
 }
 
+std::optional<std::string_view> json_field(std::string_view text, std::string_view key) {
+  const std::string quoted = "\"" + std::string(key) + "\":";
+  const auto at = text.find(quoted);
+  if (at == std::string_view::npos) return std::nullopt;
+  const std::string_view value = text.substr(at + quoted.size());
+  return value.substr(0, value.find_first_of(",}"));
+}
+
 std::vector<Estimate> read_estimates(const fs::path& out_dir, int fingers) {
   const fs::path file = out_dir / "estimates.jsonl";
   std::ifstream in(file);
@@ -211,16 +219,12 @@ std::vector<Estimate> read_estimates(const fs::path& out_dir, int fingers) {
     const std::string where = file.string() + ":" + std::to_string(n) + ": ";
     // A key of the row's own (a --score-truth "reference" object comes after them).
     const std::string own = line.substr(0, line.find(",\"reference\":{"));
-    const auto value_at = [&](const std::string& key) -> std::optional<std::string_view> {
-      const auto at = own.find("\"" + key + "\":");
-      if (at == std::string::npos) return std::nullopt;
-      return std::string_view(own).substr(at + key.size() + 3);
-    };
+    const auto value_at = [&](const std::string& key) { return json_field(own, key); };
     const auto number = [&](const std::string& key, bool may_be_null) {
       const auto v = value_at(key);
       if (!v) throw InputError(where + "no '" + key + "'; expected a row of gtrack's estimates.jsonl");
-      if (may_be_null && v->substr(0, 4) == "null") return std::numeric_limits<double>::quiet_NaN();
-      const std::string text(v->substr(0, v->find_first_of(",}")));
+      if (may_be_null && *v == "null") return std::numeric_limits<double>::quiet_NaN();
+      const std::string text(*v);
       char* end = nullptr;
       const double x = std::strtod(text.c_str(), &end);
       if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x)) {
@@ -246,7 +250,7 @@ std::vector<Estimate> read_estimates(const fs::path& out_dir, int fingers) {
                        std::to_string(fingers) + " fingers");
     }
     const auto status = value_at("status");
-    const std::string text = status ? std::string(status->substr(0, status->find(','))) : std::string();
+    const std::string text = status ? std::string(*status) : std::string();
     if (text == "\"ok\"") {
       e.status = TrackStatus::Tracked;
     } else if (text == "\"search\"") {
