@@ -126,6 +126,48 @@ TEST(SmoothOrientations, LeavesASmoothTrackAndAZeroSigmaAlone) {
   }
 }
 
+// Edge-on (a tilt of 89 deg about y) rx and rz trade off: each row of a
+// slow turn written with its own split of the two, and as one of its
+// symmetric equivalents, is still one orientation, and the fit keeps it.
+// Equivalents ranked by their Euler angles' differences would take, for
+// a row 60 deg apart from the previous one in rx and rz and 1 deg apart
+// as a rotation, another equivalent, 59 deg away, and pull the rows apart.
+TEST(SmoothOrientations, AGripperSeenEdgeOnKeepsItsOrientationWhateverItsEulerSplit) {
+  auto gripper = make_gripper("plugin = \"hydrogel_six_finger\"");
+  const auto& model = gripper->model();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> split(30.0, 60.0);
+  std::uniform_int_distribution<int> which(0, 1);
+  const int n = 40;
+  std::vector<Eigen::VectorXd> truth, written;
+  for (int i = 0; i < n; ++i) {
+    Eigen::VectorXd h = truth_at(0);
+    h[3] = 0;
+    h[4] = 89;
+    h[5] = 0.5 * i;
+    truth.push_back(h);
+    // R = Rz(rz) Ry(89) Rx(rx): about Ry(90), a turn of rx is one of -rz.
+    const double a = i % 2 ? split(rng) : -split(rng);
+    Eigen::VectorXd w = h;
+    w[3] += a;
+    w[5] += a;
+    ASSERT_LT(angle_deg(w, h), 1.2) << i;
+    // As itself or turned by half a turn about its normal: both edge-on.
+    written.push_back(model.symmetric_equivalent(w, 3 * which(rng)));
+  }
+  auto rows = rows_of(written);
+  const double change = gtrack::smooth_orientations(model, rows, 1.5);
+  EXPECT_LT(change, 1.0);
+  for (int i = 0; i < n; ++i) {
+    double e = 1e9;
+    for (int k = 0; k < 6; ++k) {
+      e = std::min(e, angle_deg(rows[static_cast<std::size_t>(i)].hypothesis,
+                                model.symmetric_equivalent(truth[static_cast<std::size_t>(i)], k)));
+    }
+    EXPECT_LT(e, 1.5) << i;
+  }
+}
+
 TEST(SmoothOrientations, ARowTheImageBarelySupportsCountsLittle) {
   auto gripper = make_gripper("plugin = \"hydrogel_six_finger\"");
   const auto& model = gripper->model();

@@ -78,10 +78,8 @@ GTRACK_API std::string smoothing_report(const TwoPassSummary& summary);
 // the row's own equivalent. Position and joints are left as they are.
 // Returns the mean change of orientation (deg) over the rows that are not
 // lost; sigma <= 0 changes nothing. `sigma` counts rows of the table: with
-// `--every K`, K times as many frames of the input. `frame`: the sensor's
-// (sensor_frame), in which the equivalents are compared.
-GTRACK_API double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma,
-                                      const SensorFrame& frame = {});
+// `--every K`, K times as many frames of the input.
+GTRACK_API double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma);
 
 // The choice between two candidates per frame (0 the forward estimate, 1
 // the backward one), over a whole table: costs[i][from][to] is the cost of

@@ -2,30 +2,29 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
-#include <cmath>
 #include <limits>
 
 #include "gtrack/model.hpp"
-#include "gtrack/sensor.hpp"
 
 namespace gtrack::detail {
 
-// Of h's symmetric equivalents (the same silhouette), the one whose angles
-// are nearest `to`'s, so that the temporal term compares like with like.
-// The angles are compared in `frame`, the sensor's (the tracker's; for a
-// sensor turned in the world, the world's angles can be near gimbal lock
-// where the sensor's are not).
+// Of h's symmetric equivalents (the same silhouette), the one whose
+// orientation is nearest `to`'s, so that the temporal term and the
+// two-pass fits compare like with like. Nearest is the angle of the
+// rotation between the two orientations, which no frame changes: Euler
+// angles' differences would not do near a 90 deg tilt about y, where rx
+// and rz trade off (two orientations 1 deg apart can differ by 60 deg in
+// each).
 inline Eigen::VectorXd nearest_equivalent(const ArticulatedModel& model, const Eigen::VectorXd& h,
-                                          const Eigen::VectorXd& to, const SensorFrame& frame = {}) {
+                                          const Eigen::VectorXd& to) {
   Eigen::VectorXd best = h;
   double nearest = std::numeric_limits<double>::infinity();
-  const Eigen::VectorXd to_in_frame = frame.from_world(to);
+  const Eigen::Matrix3d to_rotation_t = rotation_from_euler_deg(to[3], to[4], to[5]).transpose();
   for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
     const Eigen::VectorXd e = model.symmetric_equivalent(h, k);
-    const Eigen::VectorXd e_in_frame = frame.from_world(e);
-    double d = 0;
-    for (int a = 3; a < kPoseDims; ++a) d += std::pow(std::remainder(e_in_frame[a] - to_in_frame[a], 360.0), 2);
+    const double d = Eigen::AngleAxisd(rotation_from_euler_deg(e[3], e[4], e[5]) * to_rotation_t).angle();
     if (d < nearest) {
       nearest = d;
       best = e;

@@ -472,7 +472,6 @@ void check_resumed_folder(const TrackOptions& options, ImageSize size, double fp
 
 TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, const TrackOptions& options) {
   const auto start = Clock::now();
-  const SensorFrame view = sensor_frame(*setup.sensor);  // symmetric equivalents are compared in it
   // Inputs are checked before anything is written.
   {
     std::error_code ec;
@@ -891,7 +890,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       previous_index = frame->index;
       if (const auto row = reference_rows.find(frame->index); row != reference_rows.end()) {
         // Of the reference's symmetric equivalents, the one nearest the estimate.
-        const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis, view);
+        const Eigen::VectorXd reference = detail::nearest_equivalent(setup.model(), row->second, e.hypothesis);
         e.reference_terms = tracker.score(reference);
         ++references_used;
       }

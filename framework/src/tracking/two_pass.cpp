@@ -67,8 +67,7 @@ std::string smoothing_report(const TwoPassSummary& summary) {
   return text;
 }
 
-double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma,
-                           const SensorFrame& frame) {
+double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>& rows, double sigma) {
   if (!(sigma > 0) || rows.empty()) return 0;
   const std::size_t n = rows.size();
   // Each row as its symmetric equivalent nearest the previous row's.
@@ -78,7 +77,7 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
   std::optional<std::size_t> previous;
   for (std::size_t i = 0; i < n; ++i) {
     if (rows[i].status == TrackStatus::Lost) continue;
-    aligned[i] = previous ? detail::nearest_equivalent(model, rows[i].hypothesis, aligned[*previous], frame) : rows[i].hypothesis;
+    aligned[i] = previous ? detail::nearest_equivalent(model, rows[i].hypothesis, aligned[*previous]) : rows[i].hypothesis;
     q[i] = Eigen::Quaterniond(rotation_from_euler_deg(aligned[i][3], aligned[i][4], aligned[i][5]));
     used[i] = true;
     previous = i;
@@ -137,7 +136,7 @@ double smooth_orientations(const ArticulatedModel& model, std::vector<Estimate>&
     h.segment<3>(3) = euler_deg_from_rotation(fitted.toRotationMatrix());
     change += a.norm() * 180.0 / std::numbers::pi;
     ++changed;
-    out[i] = detail::nearest_equivalent(model, h, rows[i].hypothesis, frame);
+    out[i] = detail::nearest_equivalent(model, h, rows[i].hypothesis);
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (used[i]) rows[i].hypothesis = out[i];
@@ -174,7 +173,6 @@ std::vector<int> cheapest_path(const std::vector<std::array<std::array<double, 2
 TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const TrackOptions& options,
                         const std::vector<Estimate>& forward) {
   const auto start = std::chrono::steady_clock::now();
-  const SensorFrame view = sensor_frame(*setup.sensor);  // symmetric equivalents are compared in it
   if (options.input.rfind("camera:", 0) == 0) {
     throw InputError("the backward pass goes back over a recording, not a live camera (" + options.input + ")");
   }
@@ -291,7 +289,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
     if (pose_text(e.hypothesis) != pose_text(f.hypothesis)) ++differ;  // (the forward run may have been read back)
     const Estimate& b = backward[k];
     if (b.status != TrackStatus::Lost) {
-      const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis, view);
+      const Eigen::VectorXd b_here = detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
       node[k][1] = without_temporal(forward_again.score(b_here));
     }
     if (e.status != TrackStatus::Lost || b.status == TrackStatus::Lost) node[k][0] = without_temporal(e.terms);
@@ -308,7 +306,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
         edge[k][from][to] = node[k][to];
         if (k == 0 || node[k][to] == kNone || candidate(k - 1, from).status == TrackStatus::Lost) continue;
         const Eigen::VectorXd h =
-            to == 0 ? e.hypothesis : detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis, view);
+            to == 0 ? e.hypothesis : detail::nearest_equivalent(setup.model(), b.hypothesis, e.hypothesis);
         edge[k][from][to] = without_temporal(forward_again.score_after(h, candidate(k - 1, from).hypothesis));
       }
     }
@@ -331,7 +329,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // mirror), the estimate that continues its neighbours' is taken.
   const auto step = [&](std::size_t i, int from, int to) {
     const Eigen::VectorXd& h = candidate(i, to).hypothesis;
-    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate(i - 1, from).hypothesis, h, view);
+    const Eigen::VectorXd before = detail::nearest_equivalent(setup.model(), candidate(i - 1, from).hypothesis, h);
     return lt * forward_again.temporal_term(h, before);
   };
   std::vector<std::array<std::array<double, 2>, 2>> costs(forward.size());
@@ -355,7 +353,7 @@ TwoPassSummary two_pass(const Setup& setup, const EngineConfig& config, const Tr
   // the neighbouring frames' estimates average out; the orientation, the
   // weakly seen part of it, is averaged over a few frames (docs/tracker.md).
   summary.smoothed = config.tracker.two_pass_smoothing > 0;
-  summary.smoothing_change_deg = smooth_orientations(setup.model(), taken, config.tracker.two_pass_smoothing, view);
+  summary.smoothing_change_deg = smooth_orientations(setup.model(), taken, config.tracker.two_pass_smoothing);
   ResultWriter two_pass_results(options.out_dir / "two_pass", setup.model().fingers());
   for (const Estimate& e : taken) two_pass_results.write(e);
   two_pass_results.close();
