@@ -273,6 +273,10 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   // --frames and --every as the run had them: only the frames it tracked are judged.
   const gtrack::FrameRange range = gtrack::cli::frame_range_option(vm);
   const bool had_rows = !truth.rows.empty();
+  // The truth's last frame before --frames cuts it: a hint below names the
+  // range the run took within the whole sequence.
+  int truth_last = 0;
+  for (const auto& r : truth.rows) truth_last = std::max(truth_last, r.frame);
   for (auto* t : {&truth, &estimates}) {
     std::erase_if(t->rows, [&](const auto& r) { return !range.contains(r.frame); });
     // Frame order, whatever the files' (a table put together by hand): the
@@ -330,7 +334,7 @@ int run_eval(const gtrack::cli::CommonOptions& common, const po::variables_map& 
       stride = std::gcd(stride, std::abs(estimates.rows[i].frame - estimates.rows[i - 1].frame));
     }
     const int first = estimates.rows.front().frame, last = estimates.rows.back().frame;
-    const bool ends_early = last + std::max(stride, 1) <= truth.rows.back().frame;
+    const bool ends_early = last + std::max(stride, 1) <= truth_last;
     if (stride > 1 || first > truth.rows.front().frame || ends_early) {
       std::string options = "--frames " + std::to_string(first) + ":" + (ends_early ? std::to_string(last + 1) : "");
       if (stride > 1) options += " --every " + std::to_string(stride);

@@ -19,6 +19,7 @@
 #include "gtrack/log.hpp"
 #include "gtrack/observation.hpp"
 #include "gtrack/renderer.hpp"
+#include "gtrack/results.hpp"
 #include "gtrack/setup.hpp"
 
 namespace po = boost::program_options;
@@ -99,6 +100,13 @@ int run_segment(const gtrack::cli::CommonOptions& common, const po::variables_ma
   auto source = gtrack::open_frame_source(input, size, range, config.tracker.fps > 0 ? config.tracker.fps : 30.0);
   source->set_image_bits(config.tracker.image_bits);
   const gtrack::Segmenter segmenter(o, size, size);
+  // An earlier run's images would stand among this one's (other --frames,
+  // --every): they go once the input has opened, as track's do.
+  if (const int stale = gtrack::remove_frame_images(out / "masks") + gtrack::remove_frame_images(out / "preview");
+      stale > 0) {
+    gtrack::logger().warn("{} holds an earlier run's masks and previews: its {} images are replaced", out.string(),
+                          stale);
+  }
 
   const bool luminance = o.color_space == "luminance";
   const std::string bounds =

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -81,13 +83,19 @@ void plot(const fs::path& file, const std::string& title, const std::string& xla
   const cv::Scalar colours[] = {{200, 80, 30}, {40, 160, 40}, {30, 30, 220}, {160, 40, 160}, {20, 150, 200}};
   for (size_t s = 0; s < series.size(); ++s) {
     const cv::Scalar c = colours[s % 5];
-    cv::Point prev;
+    std::optional<cv::Point> prev;
     for (size_t i = 0; i < series[s].x.size(); ++i) {
+      // A cell without a frame to judge (all lost) has no point, and the
+      // line does not pass through it.
+      if (!std::isfinite(series[s].y[i])) {
+        prev.reset();
+        continue;
+      }
       const cv::Point p(px(series[s].x[i]).x, py(series[s].y[i]));
       cv::line(img, {p.x, py(std::max(0.0, series[s].y[i] - series[s].err[i]))},
                {p.x, py(series[s].y[i] + series[s].err[i])}, c, 1, cv::LINE_AA);
       cv::circle(img, p, 4, c, cv::FILLED, cv::LINE_AA);
-      if (i) cv::line(img, prev, p, c, 2, cv::LINE_AA);
+      if (prev) cv::line(img, *prev, p, c, 2, cv::LINE_AA);
       prev = p;
     }
     cv::line(img, {W - R + 15, T + 20 + 22 * int(s)}, {W - R + 40, T + 20 + 22 * int(s)}, c, 2, cv::LINE_AA);
@@ -149,6 +157,7 @@ fs::path make_sequence(const Context& c, std::uint64_t seed, double noise) {
 struct Cell {
   double endpoint = 0, endpoint_sd = 0, inplane = 0, depth = 0, orientation = 0, joints = 0, joints_sd = 0, fps = 0;
   int lost = 0, frames = 0;
+  int judged = 0;  // in-view frames with an estimate, whose errors these are
 };
 
 Cell run_cell(const Context& c, double noise, int particles, int generations) {
@@ -173,14 +182,20 @@ Cell run_cell(const Context& c, double noise, int particles, int generations) {
     cell.lost += run.evaluation.lost_in_view_frames;
     cell.frames += run.frames;
   }
+  // Errors of no frame at all (every one lost or out of view) are NaN, not
+  // 0: written "nan" and left off the plot, never the grid's best cell.
+  const auto none = std::numeric_limits<double>::quiet_NaN();
+  const auto mean = [&](const gtrack::ErrorStats& e) { return e.count > 0 ? e.mean : none; };
+  const auto sd = [&](const gtrack::ErrorStats& e) { return e.count > 0 ? e.std : none; };
   const gtrack::ErrorStats ends = gtrack::pooled(endpoint), folds = gtrack::pooled(joints);
-  cell.endpoint = ends.mean;
-  cell.endpoint_sd = ends.std;
-  cell.inplane = gtrack::pooled(inplane).mean;
-  cell.depth = gtrack::pooled(depth).mean;
-  cell.orientation = gtrack::pooled(orientation).mean;
-  cell.joints = folds.mean;
-  cell.joints_sd = folds.std;
+  cell.judged = ends.count;
+  cell.endpoint = mean(ends);
+  cell.endpoint_sd = sd(ends);
+  cell.inplane = mean(gtrack::pooled(inplane));
+  cell.depth = mean(gtrack::pooled(depth));
+  cell.orientation = mean(gtrack::pooled(orientation));
+  cell.joints = mean(folds);
+  cell.joints_sd = sd(folds);
   return cell;
 }
 
@@ -241,8 +256,10 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
     gtrack::SetupOptions so;
     so.plugin_paths = c.common.plugin_paths;
     const gtrack::Setup setup = gtrack::load_setup(c.config, so);
-    (void)gtrack::engine_config(setup);
+    const gtrack::ObservationConfig bounds = gtrack::engine_config(setup).observation;
     gtrack::check_root_keys(setup);
+    // A config without --preset: sequences its bounds can track, as synth makes.
+    c.synth.preset = gtrack::cli::synth_preset_for(vm, c.config, setup, bounds);
   }
   gtrack::cli::make_output_folder(c.out, "out");
 
@@ -256,9 +273,14 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
       for (double n : particles) {
         const Cell cell = run_cell(c, 0, static_cast<int>(n), static_cast<int>(g));
         write_row(csv, std::to_string(int(n)) + "," + std::to_string(int(g)), cell);
-        std::printf("6a  N=%3d G=%3d  endpoints %7.1f um  in-plane %6.1f um  orientation %5.2f deg  joints %5.2f "
-                    "deg  lost %d  %.1f frames/s\n",
-                    int(n), int(g), cell.endpoint, cell.inplane, cell.orientation, cell.joints, cell.lost, cell.fps);
+        if (cell.judged == 0) {
+          std::printf("6a  N=%3d G=%3d  no frame to judge: lost %d of %d  %.1f frames/s\n", int(n), int(g), cell.lost,
+                      cell.frames, cell.fps);
+        } else {
+          std::printf("6a  N=%3d G=%3d  endpoints %7.1f um  in-plane %6.1f um  orientation %5.2f deg  joints %5.2f "
+                      "deg  lost %d  %.1f frames/s\n",
+                      int(n), int(g), cell.endpoint, cell.inplane, cell.orientation, cell.joints, cell.lost, cell.fps);
+        }
         std::fflush(stdout);
         s.x.push_back(n);
         s.y.push_back(cell.endpoint);
@@ -280,8 +302,12 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
       char head[64];
       std::snprintf(head, sizeof head, "%g,%d,%d", sigma, n, g);
       write_row(csv, head, cell);
-      std::printf("6b  sigma=%.2f deg  joints %5.2f +- %5.2f deg  endpoints %7.1f um  lost %d\n", sigma, cell.joints,
-                  cell.joints_sd, cell.endpoint, cell.lost);
+      if (cell.judged == 0) {
+        std::printf("6b  sigma=%.2f deg  no frame to judge: lost %d of %d\n", sigma, cell.lost, cell.frames);
+      } else {
+        std::printf("6b  sigma=%.2f deg  joints %5.2f +- %5.2f deg  endpoints %7.1f um  lost %d\n", sigma, cell.joints,
+                    cell.joints_sd, cell.endpoint, cell.lost);
+      }
       std::fflush(stdout);
       s.x.push_back(sigma);
       s.y.push_back(cell.joints);
@@ -304,7 +330,10 @@ GTRACK_COMMAND(
     [](po::options_description& d) {
       d.add_options()("out,o", po::value<std::string>()->default_value("gtrack_sweep"), "folder to write")(
           "config,c", po::value<std::string>(), "config (default: the preset's built-in config)")(
-          "preset", po::value<std::string>()->default_value("microscope"), "synthetic setup")(
+          "preset", po::value<std::string>()->default_value("microscope"),
+          ("synthetic setup, one of " + gtrack::synth_preset_names() +
+           "; with --config and no --preset, one whose frames the config can track, as gtrack synth takes it")
+              .c_str())(
           "frames,n", po::value<int>()->default_value(60), "frames per sequence (paper: 5614 frames in all)")(
           "sequences", po::value<int>()->default_value(1), "sequences per cell, seeds seed, seed+1, ...")(
           "seed,s", po::value<std::string>()->default_value("1"), "first seed")(

@@ -16,27 +16,6 @@ namespace po = boost::program_options;
 
 namespace {
 
-// Whether an HSV colour (OpenCV units) is within the bounds; a grey one by
-// its luminance (its value) for grey-level bounds.
-bool within(const cv::Vec3d& hsv, const gtrack::ObservationConfig& o) {
-  if (o.color_space == "luminance") return hsv[2] >= o.luminance_min && hsv[2] <= o.luminance_max;
-  const bool hue = o.hue_min <= o.hue_max ? hsv[0] >= o.hue_min && hsv[0] <= o.hue_max
-                                          : hsv[0] >= o.hue_min || hsv[0] <= o.hue_max;
-  return hue && hsv[1] >= o.saturation_min && hsv[1] <= o.saturation_max && hsv[2] >= o.value_min &&
-         hsv[2] <= o.value_max;
-}
-
-// A preset's frames are ones the bounds find the gripper in, and not its
-// background.
-bool look_fits(const gtrack::SynthPreset& p, const gtrack::ObservationConfig& o) {
-  return within(p.gripper_hsv, o) && !within(p.tissue_hsv, o);
-}
-
-std::string look_text(const cv::Vec3d& hsv, bool grey) {
-  return grey ? fmt::format("luminance {:g}", hsv[2])
-              : fmt::format("hue {:g}, saturation {:g}, value {:g}", hsv[0], hsv[1], hsv[2]);
-}
-
 int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
   gtrack::SynthOptions o;
   o.preset = vm["preset"].as<std::string>();
@@ -75,54 +54,7 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
   // and its `track it:` line must not fail on them.
   const gtrack::ObservationConfig bounds = gtrack::engine_config(setup).observation;
   gtrack::check_root_keys(setup);
-  // A config given without --preset: the preset whose config it is, else
-  // the one whose config names the same gripper plugin (a lab's own copy
-  // of a shipped config), else one whose look the config's bounds find: an
-  // ultrasound slice's for a slab sensor, else the first in the table
-  // (colour microscope frames; for grey-level bounds, a bright gripper on
-  // dark speckle or a dark one in bright field, as the bounds say), so that
-  // the frames are ones the config can track.
-  const bool grey_look = bounds.color_space == "luminance";
-  const auto grey = [](const gtrack::SynthPreset& p) { return p.gripper_hsv[1] == 0; };
-  const auto fits = [&](const gtrack::SynthPreset& p) { return grey(p) == grey_look && look_fits(p, bounds); };
-  if (vm.count("config") && vm["preset"].defaulted()) {
-    const auto& all = gtrack::synth_presets();
-    const auto gripper_of = [](const gtrack::ConfigTable& root) {
-      return root.table("gripper").string_or("plugin", "");
-    };
-    const std::string gripper = gripper_of(setup.root);
-    const auto same = std::find_if(all.begin(), all.end(), [&](const auto& p) {
-      return p.config == config.filename() && fits(p);
-    });
-    const auto same_gripper = std::find_if(all.begin(), all.end(), [&](const auto& p) {
-      return fits(p) &&
-             gripper_of(gtrack::ConfigTable::load_file((gtrack::data_dir() / "configs" / p.config).string())) ==
-                 gripper;
-    });
-    const bool slab = gtrack::cli::images_a_slab(*setup.sensor);
-    const auto any = std::find_if(all.begin(), all.end(), [&](const auto& p) {
-      return fits(p) && (!slab || p.name == "ultrasound");
-    });
-    o.preset = same != all.end()           ? same->name
-               : same_gripper != all.end() ? same_gripper->name
-               : any != all.end()          ? any->name
-               : grey_look                 ? "ultrasound"
-                                           : "microscope";
-  }
-  const gtrack::SynthPreset& chosen = gtrack::synth_preset(o.preset);
-  if (const bool grey_frames = grey(chosen); grey_frames != grey_look) {
-    gtrack::logger().warn("--preset {} draws {} frames, but {} segments {}: its config will not find the "
-                          "gripper in them (leave --preset out to take one it can)",
-                          o.preset, grey_frames ? "grey-level" : "colour", config.string(),
-                          grey_look ? "grey levels" : "colour");
-  } else if (!look_fits(chosen, bounds)) {
-    gtrack::logger().warn("--preset {} draws its gripper at {}, its background at {}, but the [observation] bounds "
-                          "of {} do not take the one without the other: its config will not track the frames{}",
-                          o.preset, look_text(chosen.gripper_hsv, grey_look), look_text(chosen.tissue_hsv, grey_look),
-                          config.string(),
-                          vm["preset"].defaulted() ? " (no preset draws what they look for)"
-                                                   : " (leave --preset out to take one it can)");
-  }
+  o.preset = gtrack::cli::synth_preset_for(vm, config, setup, bounds);
   const std::filesystem::path out = gtrack::cli::out_folder(vm);
   const gtrack::SynthSummary s = gtrack::write_synthetic_sequence(setup, o, out);
   std::string unit;

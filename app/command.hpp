@@ -20,7 +20,9 @@
 #include <vector>
 
 #include "gtrack/error.hpp"
+#include "gtrack/engine_config.hpp"
 #include "gtrack/sensor.hpp"
+#include "gtrack/setup.hpp"
 
 namespace gtrack::cli {
 
@@ -168,6 +170,13 @@ inline bool images_a_slab(const gtrack::Sensor& sensor) {
   const Eigen::Vector3d a = p.clip_planes[0].head<3>().normalized(), b = p.clip_planes[1].head<3>().normalized();
   return std::abs(std::abs(a.dot(axis)) - 1) < 1e-6 && a.dot(b) < -1 + 1e-6;
 }
+
+// The synthetic preset to draw a config's frames with (gtrack synth, gtrack
+// sweep): --preset when given; for a --config without it, one whose frames
+// that config can track. Warns when the preset's look is not one the
+// config's [observation] bounds take. (app/synth_preset.cpp)
+std::string synth_preset_for(const boost::program_options::variables_map& vm, const std::filesystem::path& config,
+                             const gtrack::Setup& setup, const gtrack::ObservationConfig& bounds);
 
 }  // namespace gtrack::cli
 

@@ -531,6 +531,34 @@ TEST(Cli, SweepWritesTheFiguresAndRemakesSequencesMadeOtherwise) {
   EXPECT_EQ(count_files(dir / "sequences" / "seq_seed1_noise1" / "frames", ".png"), 5);
 }
 
+// sweep given a config and no --preset makes the sequences gtrack synth
+// would make from it (not the microscope preset's hydrogel frames); a cell
+// in which no frame could be judged has no error, not an error of 0.
+TEST(Cli, SweepTakesThePresetItsConfigTracksAndLeavesACellOfLostFramesBlank) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "sweep_preset";
+  fs::remove_all(dir);
+  const fs::path configs = fs::path(GTRACK_TEST_SOURCE_DIR) / "configs";
+  const std::string tiny = " --particles 4 --generations 2 --figure 6a --frames 3";
+  CliRun r = gtrack("sweep --config " + (configs / "microscope_metallic_two.toml").string() + tiny + " --out " +
+                    (dir / "two").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string made = read_file(dir / "two" / "sequences" / "seq_seed1_noise0" / "made_from.txt");
+  EXPECT_NE(made.find("preset metallic_two\n"), std::string::npos) << made;
+  // Colour frames for a config that segments grey levels: every frame lost.
+  r = gtrack("sweep --config " + (configs / "ultrasound_hydrogel.toml").string() + " --preset microscope" + tiny +
+             " --out " + (dir / "lost").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("segments grey levels"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no frame to judge: lost 3 of 3"), std::string::npos) << r.output;
+  const auto rows = read_csv(dir / "lost" / "fig6a.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows[1].size(), rows[0].size());
+  for (std::size_t c = 0; c < rows[0].size(); ++c) {
+    const bool error = rows[0][c].find("_um") != std::string::npos || rows[0][c].find("_deg") != std::string::npos;
+    if (error) EXPECT_EQ(rows[1][c], "nan") << rows[0][c];
+  }
+}
+
 // A fresh run into the folder of an earlier one replaces it: no overlay,
 // mask or row of the earlier run is left beside the new results.
 TEST(Cli, TrackIntoAnEarlierRunReplacesIt) {
@@ -799,6 +827,10 @@ TEST(Cli, EvalJudgesTheFramesARunTookWithFramesAndEvery) {
                           "those (--frames 1:4 --every 2)"),
             std::string::npos)
       << r.output;
+  // Given --frames as the run had it but not --every: the end said is the
+  // run's, not that of the frames eval was given.
+  r = gtrack("eval -t " + (dir / "ground_truth.csv").string() + " -e " + early.string() + " --frames 1:4");
+  EXPECT_NE(r.output.find("(--frames 1:4 --every 2), evaluate with the same options"), std::string::npos) << r.output;
   r = gtrack(eval + " --frames 7:");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--frames/--every select none of the frames of"), std::string::npos) << r.output;
@@ -1389,6 +1421,20 @@ TEST(Cli, SegmentShowsWhatTheBoundsTakeInWholeFrames) {
   EXPECT_GT(cv::countNonZero(mask), 0.3 * face_on);
   EXPECT_LT(cv::countNonZero(mask), 1.5 * face_on);
   EXPECT_NE(r.output.find("saturation:  p1"), std::string::npos) << r.output;
+  // Again into the same folder with other frames: the earlier run's images
+  // go (a file of the user's stays), so that the folder is this run's.
+  std::ofstream(dir / "seg" / "masks" / "notes.txt") << "kept\n";
+  const CliRun again = gtrack("segment -c " + (dir / "sequence.toml").string() + " -i " + (dir / "frames").string() +
+                              " -o " + (dir / "seg").string() + " --frames 1:2");
+  ASSERT_EQ(again.code, 0) << again.output;
+  EXPECT_NE(again.output.find("holds an earlier run's masks and previews: its 4 images are replaced"),
+            std::string::npos)
+      << again.output;
+  for (const char* sub : {"masks", "preview"}) {
+    EXPECT_FALSE(fs::exists(dir / "seg" / sub / "000000.png")) << sub;
+    EXPECT_TRUE(fs::exists(dir / "seg" / sub / "000001.png")) << sub;
+  }
+  EXPECT_TRUE(fs::exists(dir / "seg" / "masks" / "notes.txt"));
   std::ofstream(dir / "blue.toml") << read_file(dir / "sequence.toml") + "\n[observation]\nhue_min = 100\nhue_max = 130\n";
   const CliRun blue = gtrack("segment -c " + (dir / "blue.toml").string() + " -i " + (dir / "frames").string() +
                              " -o " + (dir / "seg_blue" / "nested").string() + "/ --frames 0");
