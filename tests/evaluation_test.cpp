@@ -356,6 +356,14 @@ TEST(PoseTable, ReadsByHeaderAndReportsBadRows) {
   EXPECT_EQ(refusal(dir / "bom.csv", "\xEF\xBB\xBF" + header + ",status\n0,1,2,3,4,5,6,7,ok\n1,nan,nan,nan,nan,nan,nan,nan,lost\n"),
             "");
   EXPECT_EQ(gtrack::read_pose_table(dir / "bom.csv").rows.size(), 2u);
+  // gtrack's own writers put "null" for a value that is no number: read back as nan.
+  EXPECT_EQ(refusal(dir / "null.csv", header + ",status,cost\n0,1,2,3,4,5,6,7,ok,null\n1,null,null,null,null,null,"
+                                               "null,null,lost,0.5\n"),
+            "");
+  const auto nulls = gtrack::read_pose_table(dir / "null.csv");
+  ASSERT_EQ(nulls.rows.size(), 2u);
+  EXPECT_TRUE(std::isnan(nulls.rows[0].extra.at("cost")));
+  EXPECT_TRUE(std::isnan(nulls.rows[1].h[0]));
   const std::string nan_ok = refusal(dir / "nan_ok.csv", header + ",status\n0,1,2,3,4,5,6,7,ok\n1,1,2,nan,4,5,6,7,ok\n");
   EXPECT_NE(nan_ok.find("nan_ok.csv:3: expected a finite number for 'z_mm' in a row whose status is ok"),
             std::string::npos)

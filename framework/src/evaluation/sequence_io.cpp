@@ -30,7 +30,9 @@ std::vector<std::string> split_csv(const std::string& line) {
 }
 
 bool parse_number(const std::string& s, double& v) {
-  if (s == "nan" || s == "NaN") {
+  // gtrack's own tables write a value that is no number as "null" (as its
+  // JSON lines do); other tools write "nan".
+  if (s == "nan" || s == "NaN" || s == "null") {
     v = std::nan("");
     return true;
   }
