@@ -1,4 +1,4 @@
-// gtrack plugins: one line per plugin found (kind, name, version, file).
+// gtrack plugins: one line per plugin found (kind, name, version, file, summary).
 #include <algorithm>
 #include <iostream>
 
@@ -23,7 +23,12 @@ int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_o
     return 1;
   }
   for (const auto& r : records) {
-    std::cout << gtrack::to_string(r.kind) << "\t" << r.name << "\t" << r.version << "\t" << r.file.string() << "\n";
+    // The summary last: a script that takes the first four fields still can.
+    // A tab or a line break of the plugin's own would split the line.
+    std::string summary = r.summary;
+    std::replace_if(summary.begin(), summary.end(), [](char c) { return c == '\t' || c == '\n' || c == '\r'; }, ' ');
+    std::cout << gtrack::to_string(r.kind) << "\t" << r.name << "\t" << r.version << "\t" << r.file.string() << "\t"
+              << summary << "\n";
   }
   // The first file of a name is the one taken: copies further down the
   // search path (another build, an older install) are said, on stderr.
@@ -37,7 +42,7 @@ int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_o
 
 }  // namespace
 
-GTRACK_COMMAND("plugins", "list the plugins found: kind, name, version, file",
+GTRACK_COMMAND("plugins", "list the plugins found: kind, name, version, file, what it is",
                [](boost::program_options::options_description& d) {
                  d.add_options()("paths", "print the folders searched, in order, instead");
                },

@@ -67,7 +67,26 @@ void install_sigint() {
   }
 }
 
+// --stream: the estimates' lines go to what stdout was; stdout itself (fd
+// 1) is pointed at stderr before any plugin is loaded, so that what a
+// plugin prints (or a library it uses) never reaches the controller's pipe.
+std::FILE* g_stream_out = stdout;
+
+void set_stream_apart() {
+  std::fflush(stdout);
+  const int lines = ::dup(STDOUT_FILENO);
+  std::FILE* out = lines >= 0 ? ::fdopen(lines, "w") : nullptr;
+  if (!out || ::dup2(STDERR_FILENO, STDOUT_FILENO) < 0) {
+    const int error = errno;
+    if (out) std::fclose(out);
+    throw gtrack::Error(std::string("--stream: cannot set stdout apart for the estimates (") + std::strerror(error) +
+                       ")");
+  }
+  g_stream_out = out;
+}
+
 int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
+  if (vm.count("stream")) set_stream_apart();
   gtrack::SetupOptions so;
   so.plugin_paths = common.plugin_paths;
   gtrack::Setup setup = gtrack::load_setup(vm["config"].as<std::string>(), so);
@@ -127,7 +146,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
       const std::string line = gtrack::estimate_json(e) + "\n";
       if (udp) udp->send(line);
       if (!stream || g_reader_gone || g_stream_stalled) return;
-      if (std::fputs(line.c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
+      if (std::fputs(line.c_str(), g_stream_out) < 0 || std::fflush(g_stream_out) != 0) {
         const int error = errno;
         if (g_grace_over && error != EPIPE) {
           g_stream_stalled = true;
@@ -172,7 +191,7 @@ int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map&
   if (stream && opt.follow_input_s > 0) {
     reader_watch = std::jthread([](std::stop_token stop) {
       while (!stop.stop_requested() && !g_stop) {
-        pollfd out{STDOUT_FILENO, 0, 0};
+        pollfd out{::fileno(g_stream_out), 0, 0};
         if (::poll(&out, 1, 100) > 0 && (out.revents & (POLLERR | POLLHUP))) {
           g_reader_gone = true;
           g_stop = true;

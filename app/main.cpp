@@ -184,5 +184,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::cerr << "gtrack: error: " << gtrack::shown(gtrack::library_words(e.what())) << "\n";
     return 1;
+  } catch (...) {
+    // Only a plugin's code throws anything else; the calls gtrack makes to
+    // plugins name them, this is the last resort.
+    std::cerr << "gtrack: error: something that is not a std::exception was thrown (by a plugin's code)\n";
+    return 1;
   }
 }

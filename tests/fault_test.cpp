@@ -188,8 +188,8 @@ struct CliRun {
   std::string output;
 };
 
-CliRun gtrack_cli(const std::string& args) {
-  const std::string cmd = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack " + args + " 2>&1";
+CliRun gtrack_cli(const std::string& args, const std::string& redirect = "2>&1") {
+  const std::string cmd = std::string(GTRACK_TEST_BINARY_DIR) + "/bin/gtrack " + args + " " + redirect;
   FILE* p = ::popen(cmd.c_str(), "r");
   std::string out;
   std::array<char, 4096> buf;
@@ -543,6 +543,45 @@ TEST(Fault, AStimulusLogRowThePluginRefusesAtItsTimeStopsTheRunBeforeAnyFrame) {
     EXPECT_EQ(std::string(e.what()).rfind((dir / "spike.csv").string() + ":4: a change of 150", 0), 0u) << e.what();
   }
   EXPECT_FALSE(fs::exists(o.out_dir / "estimates.csv"));
+}
+
+// A plugin is someone else's code. What it prints to stdout (a debugging
+// line when made and at each reading) does not reach a controller reading
+// --stream, whose stdout holds the estimates' lines only; what it throws
+// that is not a std::exception is one line naming the plugin and the call,
+// not an abort without a word.
+TEST(Fault, APluginsPrintingAndOddThrowsStayOffTheControllersPipe) {
+  const fs::path dir = fresh_dir("chatty_plugin");
+  const auto config_with = [&](const std::string& wrong) {
+    std::string config = kConfig;
+    const size_t at = config.find("[stimulus]");
+    const size_t end = config.find("\n[", at + 1);
+    config.replace(at, end - at, "[stimulus]\nplugin = \"fixture_wrong_stimulus\"\nwrong = \"" + wrong + "\"");
+    const fs::path file = dir / (wrong + ".toml");
+    std::ofstream(file) << config;
+    return file;
+  };
+  const fs::path frames = write_frames(dir / "frames", 3);
+  std::ofstream(dir / "log.csv") << "frame,value\n0,20\n1,21\n2,22\n";
+  const auto track = [&](const std::string& wrong) {
+    return "track --plugin-path " + std::string(GTRACK_TEST_FIXTURE_DIR) + " --config " +
+           config_with(wrong).string() + " --input " + frames.string() + " --stimulus " +
+           (dir / "log.csv").string() + " --no-overlay --out " + (dir / wrong).string();
+  };
+  const CliRun streamed = gtrack_cli(track("prints") + " --stream", "2>" + (dir / "stderr.txt").string());
+  ASSERT_EQ(streamed.code, 0) << read_text(dir / "stderr.txt");
+  EXPECT_EQ(streamed.output, read_text(dir / "prints" / "estimates.jsonl"));
+  EXPECT_EQ(std::count(streamed.output.begin(), streamed.output.end(), '\n'), 3) << streamed.output;
+  // The plugin's lines went to stderr instead.
+  EXPECT_NE(read_text(dir / "stderr.txt").find("wrong_stimulus: made"), std::string::npos);
+  EXPECT_NE(read_text(dir / "stderr.txt").find("wrong_stimulus: reading 21"), std::string::npos);
+
+  const CliRun odd = gtrack_cli(track("throws_other"));
+  EXPECT_EQ(odd.code, 1) << odd.output;
+  EXPECT_NE(odd.output.find("stimulus plugin 'fixture_wrong_stimulus' ("), std::string::npos) << odd.output;
+  EXPECT_NE(odd.output.find("penalty() threw something that is not a std::exception"), std::string::npos)
+      << odd.output;
+  EXPECT_EQ(odd.output.find("terminate"), std::string::npos) << odd.output;
 }
 
 // A stimulus log shorter than the video: every frame is tracked, the frames
@@ -1091,7 +1130,8 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
 // --two-pass --resume: a two-pass run interrupted in its forward run is
 // resumed, its earlier frames read back from estimates.jsonl for the
 // backward pass, and gives the two-pass table of a run never interrupted.
-// The read-back rows are the estimates as written.
+// The read-back rows are the estimates as written, their times and
+// readings exactly as the run had them.
 TEST(Fault, ResumedTwoPassRunMakesTheTableOfAnUninterruptedOne) {
   const fs::path dir = fresh_dir("resume_two_pass");
   const CliRun synth = gtrack_cli("synth --frames 12 --seed 3 --out " + (dir / "seq").string());
@@ -1126,11 +1166,13 @@ TEST(Fault, ResumedTwoPassRunMakesTheTableOfAnUninterruptedOne) {
   ASSERT_EQ(read_back.size(), forward.size());
   for (size_t i = 0; i < forward.size(); ++i) {
     EXPECT_EQ(read_back[i].frame, forward[i].frame);
-    EXPECT_NEAR(read_back[i].time_s, forward[i].time_s, 1e-6);
+    // The run's inputs exactly (a reading or a time rounded would be fed
+    // to the stimulus again otherwise, and the tracks part ways).
+    EXPECT_EQ(read_back[i].time_s, forward[i].time_s) << i;
     EXPECT_EQ(gtrack::pose_text(read_back[i].hypothesis), gtrack::pose_text(forward[i].hypothesis)) << i;
     EXPECT_EQ(read_back[i].status, forward[i].status) << i;
     ASSERT_TRUE(read_back[i].stimulus.has_value());
-    EXPECT_NEAR(*read_back[i].stimulus, *forward[i].stimulus, 1e-6 * std::abs(*forward[i].stimulus)) << i;
+    EXPECT_EQ(*read_back[i].stimulus, *forward[i].stimulus) << i;
   }
 
   std::atomic<bool> stop{false};
@@ -1243,7 +1285,7 @@ TEST(Fault, ResumeRefusesAStimulusLogChangedSinceTheRunBegan) {
     gtrack::track_sequence(r.setup, r.config, o);
     ADD_FAILURE() << "resumed with another stimulus log";
   } catch (const gtrack::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("stimulus.csv: has changed since the interrupted run began (--stimulus: it "
+    EXPECT_NE(std::string(e.what()).find("stimulus.csv: has changed since the run being resumed began (--stimulus: it "
                                          "was 22 bytes"),
               std::string::npos)
         << e.what();
@@ -1350,7 +1392,7 @@ TEST(Fault, ResumeRefusesEstimateFilesThatDisagree) {
   // Another stride (or input, or stimulus log) would join two runs' frames.
   gtrack::TrackOptions other = again;
   other.range.every = 2;
-  expect_refusal_naming(track_error(r, other), "tracker_state.txt: the interrupted run tracked input=");
+  expect_refusal_naming(track_error(r, other), "tracker_state.txt: the run being resumed tracked input=");
   EXPECT_NE(track_error(r, other).find("every=1 stimulus=none; this one input="), std::string::npos);
   // So would another first frame: --frames 0:4, then 100:110 --resume.
   other = again;
@@ -1382,7 +1424,7 @@ TEST(Fault, ResumeRefusesAnotherConfig) {
   again.range.last = -1;
   again.resume = true;
   expect_refusal_naming(track_error(make_run("mirror_check = false\n"), again),
-                        "run_config.toml: [tracker] mirror_check was not set in the interrupted run, is false in "
+                        "run_config.toml: [tracker] mirror_check was not set in the run being resumed, is false in "
                         "fault.toml; cannot resume with another config");
   EXPECT_EQ(read_text(csv), csv_text);
   // A damaged copy is named by its line, and nothing is changed.
@@ -1484,7 +1526,7 @@ TEST(Fault, ResumeRefusesAChangedFileTheConfigNames) {
   moved.replace(moved.find("63.5"), 4, "60.5");
   std::ofstream(dir / "lab" / "camera.yml") << moved;
   expect_refusal_naming(track_error(load(dir / "lab" / "lab.toml"), again),
-                        camera_path + ": has changed since the interrupted run began ([sensor] calibration: it was " +
+                        camera_path + ": has changed since the run being resumed began ([sensor] calibration: it was " +
                             std::to_string(camera.size()) + " bytes, FNV-1a 64 ");
   EXPECT_EQ(read_text(csv), csv_text);
   // The same text in another folder names another file.

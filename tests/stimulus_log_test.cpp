@@ -142,7 +142,7 @@ TEST(StimulusLog, ALoggersNamedColumnsAreReadByName) {
     return std::string("no error");
   };
   EXPECT_EQ(error(channels, ""), "log.csv:1: the log has the columns 'B_mT', 'T_C'; say which holds the readings "
-                                 "(gtrack track --stimulus-column NAME)");
+                                 "(--stimulus-column NAME)");
   EXPECT_EQ(error(channels, "T_F"), "log.csv:1: no column 'T_F'; the log has 'B_mT', 'T_C'");
   EXPECT_EQ(error("time_s,B_mT,T_C\n0,2.5\n", "T_C"), "log.csv:2: expected 3 fields, as the header has, got '0,2.5'");
   EXPECT_EQ(error("time_s,B_mT,T_C\n0,2.5,hot\n", "T_C"), "log.csv:2: expected a number in the 'T_C' field, got 'hot'");

@@ -24,8 +24,17 @@ class CheckedStimulus final : public Stimulus {
   CheckedStimulus(std::shared_ptr<Stimulus> plugin, std::string label)
       : plugin_(std::move(plugin)), label_(std::move(label)) {}
 
-  // A refused reading is the tracker's to report, with its frame.
-  void update(double value, double time_s) override { plugin_->update(value, time_s); }
+  // A refused reading (a std::exception) is the tracker's to report, with
+  // its frame.
+  void update(double value, double time_s) override {
+    try {
+      plugin_->update(value, time_s);
+    } catch (const std::exception&) {
+      throw;
+    } catch (...) {
+      throw PluginError(label_ + ": update() " + kNotStd);
+    }
+  }
 
   StimulusState state() const override {
     const StimulusState s = guarded("state()", [&] { return plugin_->state(); });
@@ -75,8 +84,12 @@ class CheckedStimulus final : public Stimulus {
       throw;
     } catch (const std::exception& e) {
       throw PluginError(label_ + ": " + call + " threw: " + e.what());
+    } catch (...) {
+      throw PluginError(label_ + ": " + call + " " + kNotStd);
     }
   }
+
+  static constexpr const char* kNotStd = "threw something that is not a std::exception (throw one, with a message)";
 
   std::shared_ptr<Stimulus> plugin_;
   std::string label_;

@@ -75,6 +75,13 @@ static constexpr PluginKind kTargetKind = PluginKind::Stimulus;
 #else
 static constexpr PluginKind kTargetKind{0};
 #endif
+// libstdc++'s string ABI is gtrack's (GTRACK_CXX11_ABI comes with the
+// gtrack::framework target; unknown when the target is not linked).
+#if defined(GTRACK_CXX11_ABI) && defined(_GLIBCXX_USE_CXX11_ABI)
+static constexpr bool kSameStringAbi = (GTRACK_CXX11_ABI != 0) == (_GLIBCXX_USE_CXX11_ABI != 0);
+#else
+static constexpr bool kSameStringAbi = true;
+#endif
 }  // namespace plugin_detail
 
 inline const char* to_string(PluginKind kind) {
@@ -103,6 +110,10 @@ inline const char* to_string(PluginKind kind) {
   static_assert(::gtrack::plugin_detail::kTargetKind == ::gtrack::PluginKind{0} ||                   \
                     ::gtrack::plugin_detail::kTargetKind == ::gtrack::PluginTraits<Interface>::kind, \
                 "GTRACK_PLUGIN: " #Interface " is not the KIND given to gtrack_add_plugin");        \
+  static_assert(::gtrack::plugin_detail::kSameStringAbi,                                            \
+                "GTRACK_PLUGIN: built with another _GLIBCXX_USE_CXX11_ABI than gtrack: std::string "   \
+                "differs between the two and the plugin would crash at its first call; build it "     \
+                "(and the libraries it links) without -D_GLIBCXX_USE_CXX11_ABI=0");                   \
   namespace gtrack_plugin_detail {                                                                   \
   const ::gtrack::PluginInfo plugin_info{GTRACK_PLUGIN_ABI_VERSION,                                  \
                                          sizeof(::gtrack::PluginInfo),                               \

@@ -96,6 +96,10 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
       } catch (const std::exception& e) {
         throw PluginError(fmt::format("{}: kinematic_penalty() threw for the joints [{}] deg: {}", gripper_label_,
                                       joint_list(), e.what()));
+      } catch (...) {
+        throw PluginError(fmt::format("{}: kinematic_penalty() threw something that is not a std::exception for the "
+                                      "joints [{}] deg",
+                                      gripper_label_, joint_list()));
       }
       if (!std::isfinite(out[i].kinematic)) {
         throw PluginError(fmt::format("{}: kinematic_penalty() returned {} for the joints [{}] deg; expected a "

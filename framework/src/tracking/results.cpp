@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -35,6 +36,17 @@ std::string num(double v, const char* fmt) {
   char buf[64];
   std::snprintf(buf, sizeof buf, fmt, v);
   return buf;
+}
+
+// The shortest text that reads back as the same double (22.5 as "22.5",
+// 1/30 with its 16 digits): a run's inputs, a frame's time and reading,
+// which a resumed --two-pass run reads back and feeds to the tracker again
+// exactly as the run had them.
+std::string exact(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[64];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : num(v, "%.17g");
 }
 
 // The length of the well-formed UTF-8 sequence at text[i] (1 to 4), or 0.
@@ -160,7 +172,7 @@ void ResultWriter::sync() {
 
 std::string estimate_json(const Estimate& e) {
   const Eigen::VectorXd& h = e.hypothesis;
-  std::string j = "{\"frame\":" + std::to_string(e.frame) + ",\"time_s\":" + num(e.time_s, "%.6f");
+  std::string j = "{\"frame\":" + std::to_string(e.frame) + ",\"time_s\":" + exact(e.time_s);
   for (Eigen::Index i = 0; i < h.size(); ++i) {
     j += ",\"" + parameter_name(static_cast<int>(i)) + "\":" + num(h[i], i < 3 ? "%.6f" : "%.4f");
   }
@@ -179,7 +191,7 @@ std::string estimate_json(const Estimate& e) {
   j += ",\"unseen_fingers\":[";
   for (std::size_t k = 0; k < e.unseen_fingers.size(); ++k) j += (k ? "," : "") + std::to_string(e.unseen_fingers[k]);
   j += "]";
-  j += ",\"stimulus\":" + (e.stimulus ? num(*e.stimulus, "%.9g") : std::string("null"));
+  j += ",\"stimulus\":" + (e.stimulus ? exact(*e.stimulus) : std::string("null"));
   if (e.stimulus_age_s) j += ",\"stimulus_age_s\":" + num(*e.stimulus_age_s, "%.3f");
   j += ",\"observed_pixels\":" + std::to_string(e.observed_pixels) + ",\"evaluations\":" +
        std::to_string(e.evaluations);

@@ -230,12 +230,12 @@ void check_same_config(const fs::path& file, const ConfigTable& root, const std:
   try {
     d = first_difference(ConfigTable::load_file(file.string()), root);
   } catch (const Error& e) {
-    throw InputError(std::string(e.what()) + "; cannot resume (this is the interrupted run's config)");
+    throw InputError(std::string(e.what()) + "; cannot resume (this is the config of the run being resumed)");
   }
   const std::string now = root.source().empty() ? std::string("this config") : shown(root.source(), 1 << 12);
   const std::string copy = shown(file.string(), 1 << 12);
   if (d) {
-    throw InputError(copy + ": " + d->key + " was " + d->first + " in the interrupted run, is " +
+    throw InputError(copy + ": " + d->key + " was " + d->first + " in the run being resumed, is " +
                      d->second + " in " + now +
                      "; cannot resume with another config (give the config the run was started with, which this "
                      "file copies and names, or another --out)");
@@ -253,11 +253,11 @@ void check_same_config(const fs::path& file, const ConfigTable& root, const std:
     const std::string path_shown = displayed(it->path);
     if (path != kept.path && !(kept_path && fs::equivalent(*kept_path, it->path, ec))) {
       throw InputError(copy + ": " + kept.key + " was the file " + kept_shown +
-                       " in the interrupted run, is " + path_shown + " with " + now +
-                       "; cannot resume with another file (give the files of the interrupted run, or another --out)");
+                       " in the run being resumed, is " + path_shown + " with " + now +
+                       "; cannot resume with another file (give the files of the run being resumed, or another --out)");
     }
     if (const std::string print = fingerprint(it->path); print != kept.fingerprint) {
-      throw InputError(path_shown + ": has changed since the interrupted run began (" + kept.key + ": it was " +
+      throw InputError(path_shown + ": has changed since the run being resumed began (" + kept.key + ": it was " +
                        kept.fingerprint + ", is " + print +
                        "); cannot resume with another file (restore it, or choose another --out)");
     }

@@ -137,7 +137,7 @@ void StimulusLog::take_line(std::string line) {
     for (size_t i = 1; i < fields.size(); ++i) names += (i > 1 ? ", " : "") + field_text(fields[i]);
     if (column_.empty() && fields.size() > 2) {
       throw InputError(where + "the log has the columns " + names +
-                       "; say which holds the readings (gtrack track --stimulus-column NAME)");
+                       "; say which holds the readings (--stimulus-column NAME)");
     }
     const auto at = column_.empty() ? fields.begin() + 1 : std::find(fields.begin() + 1, fields.end(), column_);
     if (at == fields.end()) throw InputError(where + "no column " + field_text(column_) + "; the log has " + names);

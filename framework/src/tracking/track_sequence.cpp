@@ -462,7 +462,7 @@ void check_resumed_folder(const TrackOptions& options, ImageSize size, double fp
       if (before == '/' || before == '"') return;
     }
   }
-  throw InputError(options.input + ": frame " + std::to_string(frame) + " was " + was + " in the interrupted run, " +
+  throw InputError(options.input + ": frame " + std::to_string(frame) + " was " + was + " in the run being resumed, " +
                    (now ? "is now " + json_string(now->name) : std::string("is now past the folder's last image")) +
                    " (images removed, added or renamed before it); cannot resume, the frames would be numbered "
                    "otherwise (put the images back as they were, or start a new run with another --out)");
@@ -555,7 +555,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       ran.insert(ran.find(" every="), " from=0");
     }
     if (!ran.empty() && ran != run) {
-      throw InputError(state_file.string() + ": the interrupted run tracked " + shown(ran, 300) +
+      throw InputError(state_file.string() + ": the run being resumed tracked " + shown(ran, 300) +
                        "; this one " + shown(run, 300) +
                        "; cannot resume (give the same --input, first frame of --frames, --every, --stimulus, "
                        "--stimulus-column and --stimulus-offset, or another --out; a run that followed its stimulus "
