@@ -983,6 +983,23 @@ TEST(Fault, DiskFullMidRunStopsWithOneLine) {
   EXPECT_LE(valid_rows(out / "estimates.csv").size(), 1u);
 }
 
+// A disk that fills part way also refuses the summary written when the run
+// stops: the error still says how many frames are kept and that --resume
+// goes on (summary.json made unwritable here by a folder in its place).
+TEST(Fault, AStopWhoseSummaryCannotBeWrittenStillSaysWhatIsKept) {
+  const fs::path dir = fresh_dir("no_summary");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  int frames_run = 0;
+  o.on_frame = [&](const gtrack::Estimate&) {
+    if (++frames_run == 2) fs::create_directories(o.out_dir / "summary.json" / "x");
+    if (frames_run == 3) throw gtrack::InputError("estimates.jsonl: write failed (No space left on device)");
+  };
+  const std::string error = track_error(r, o);
+  expect_refusal_naming(error, "write failed (No space left on device); the 2 frames before it are kept in " +
+                                   o.out_dir.string() + " (--resume goes on");
+}
+
 // The output folder is deleted while the run goes on (a user cleaning up):
 // the run stops at the next frame, failing to save its tracker state there,
 // in one line; nothing crashes and no more frames are tracked for nothing.

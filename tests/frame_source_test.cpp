@@ -600,3 +600,25 @@ TEST(FrameSource, AFloatImageIsRefusedNamingIt) {
         << e.what();
   }
 }
+
+// A PNG whose header claims 60000 x 60000 pixels (68 bytes in all): OpenCV
+// refuses it with an assertion; the error is one line naming the file.
+TEST(FrameSource, AnImageWhoseHeaderIsTooLargeIsRefusedNamingIt) {
+  const fs::path dir = folder_of("header_too_large", {});
+  const unsigned char png[] = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00,
+      0x00, 0xea, 0x60, 0x00, 0x00, 0xea, 0x60, 0x08, 0x02, 0x00, 0x00, 0x00, 0x0f, 0xb0, 0xe2, 0x15, 0x00,
+      0x00, 0x00, 0x0b, 0x49, 0x44, 0x41, 0x54, 0x78, 0xda, 0x63, 0x60, 0x40, 0x06, 0x00, 0x00, 0x0e, 0x00,
+      0x01, 0x3a, 0x35, 0x04, 0x56, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+  std::ofstream(dir / "000000.png", std::ios::binary).write(reinterpret_cast<const char*>(png), sizeof png);
+  auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
+  try {
+    src->next();
+    FAIL() << "an image of 60000 x 60000 pixels was read";
+  } catch (const gtrack::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("000000.png: cannot read the image"), std::string::npos) << what;
+    EXPECT_NE(what.find("its header gives a size above the 2^30 pixels OpenCV decodes"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}

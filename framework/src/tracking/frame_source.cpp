@@ -760,8 +760,20 @@ class FolderSource final : public FrameSource {
     const auto decode = [&p](std::string& said) {
       if (is_dicom_name(p)) return read_dicom_image(p, said);
       detail::CapturedStderr library;
-      cv::Mat img = cv::imread(p.string(), cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
+      cv::Mat img;
+      std::string refused;
+      try {
+        img = cv::imread(p.string(), cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
+      } catch (const cv::Exception& e) {
+        // OpenCV asserts on a header it will not decode (a size above its
+        // 2^30 pixels): that is this file's error, not the run's.
+        img.release();
+        refused = e.err.find("CV_IO_MAX_IMAGE_PIXELS") != std::string::npos
+                      ? "its header gives a size above the 2^30 pixels OpenCV decodes"
+                      : e.err;
+      }
       said = library.take();
+      if (!refused.empty()) said = refused + (said.empty() ? "" : "; " + said);
       return img;
     };
     std::string said;

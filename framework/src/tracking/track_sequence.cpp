@@ -943,9 +943,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       } catch (const std::exception&) {
         // A second error closing the files: the first is the one to report.
       }
-      // A resumed run that stops at its first frame leaves the earlier
-      // run's summary as it was.
-      if (summary.frames > 0) write_summary(options.out_dir / "summary.json", summary);
       const int done = summary.frames_before + summary.frames;
       const bool resumable = !options.follow_stimulus && options.input.rfind("camera:", 0) != 0;
       kept = fmt::format("; the {} frame{} before it {} kept in {}{}", done, done == 1 ? "" : "s",
@@ -953,6 +950,10 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                          resumable ? " (--resume goes on once the cause is mended; a changed config or plugin "
                                      "needs a new run)"
                                    : "");
+      // A resumed run that stops at its first frame leaves the earlier
+      // run's summary as it was. (On a full disk the summary cannot be
+      // written either; the rows are what is kept.)
+      if (summary.frames > 0) write_summary(options.out_dir / "summary.json", summary);
     } catch (const std::exception&) {
       // The error that stopped the run is the one to report.
     }
