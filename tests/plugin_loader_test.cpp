@@ -297,6 +297,21 @@ TEST(PluginLoader, SearchOrderPutsUserPathsFirst) {
   EXPECT_EQ(p[2], "/env/a");
   EXPECT_EQ(p[3], "/env/b");
   EXPECT_EQ(p[4], gtrack::default_plugin_dir());
+  // A folder named again (the built-in one in GTRACK_PLUGIN_PATH, another
+  // spelling of a user's) is searched once, at its first place.
+  const fs::path here = fs::temp_directory_path() / "gtrack_search_once";
+  fs::create_directories(here);
+  {
+    const gtrack::testing::ScopedEnv env("GTRACK_PLUGIN_PATH",
+                                         (here / ".").string() + ":" + gtrack::default_plugin_dir().string());
+    loader.emplace(std::vector<fs::path>{here, "/user/1", "/user/1"});
+  }
+  const auto& once = loader->search_paths();
+  ASSERT_EQ(once.size(), 3u);
+  EXPECT_EQ(once[0], here);
+  EXPECT_EQ(once[1], "/user/1");
+  EXPECT_EQ(once[2], gtrack::default_plugin_dir());
+  fs::remove_all(here);
 }
 
 // A plugin found in an earlier folder is taken over one of the same name in

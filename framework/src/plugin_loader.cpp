@@ -172,7 +172,16 @@ void PluginLoader::rebuild() {
   for (const auto& p : user_) all.push_back(p);
   for (const auto& p : env_paths_) all.push_back(p);
   all.push_back(default_plugin_dir());
-  paths_ = std::move(all);
+  // A folder named twice (GTRACK_PLUGIN_PATH set to the built-in folder,
+  // say) is searched, and shown in messages, once: at its first place.
+  paths_.clear();
+  for (const auto& p : all) {
+    const auto same = [&](const fs::path& q) {
+      std::error_code ec;
+      return q == p || fs::equivalent(q, p, ec);
+    };
+    if (std::none_of(paths_.begin(), paths_.end(), same)) paths_.push_back(p);
+  }
 }
 
 // A library that made an instance stays loaded until the process exits. An
