@@ -1142,6 +1142,14 @@ TEST(Fault, ResumedRunMatchesAnUninterruptedOne) {
   r = load();
   const std::string log = gtrack::testing::logged([&] { gtrack::track_sequence(r.setup, r.config, second); });
   EXPECT_NE(log.find("overlay.mp4: cannot be read (not closed by the run that wrote it"), std::string::npos) << log;
+  // After several kills, one line says how many, not one line each.
+  for (const char* name : {"overlay_from_000004.mp4", "overlay_from_000007.mp4"}) {
+    std::ofstream(dir / "out" / name) << std::string(48, '\0');
+  }
+  r = load();
+  const std::string many = gtrack::testing::logged([&] { gtrack::track_sequence(r.setup, r.config, second); });
+  EXPECT_NE(many.find("3 overlays of earlier runs cannot be read ("), std::string::npos) << many;
+  EXPECT_EQ(many.find("cannot be read (not closed by the run that wrote it"), std::string::npos) << many;
 }
 
 // --two-pass --resume: a two-pass run interrupted in its forward run is

@@ -103,10 +103,12 @@ class OverlayWriter {
 
 // The overlays of the runs before a resumed one: a video killed before it
 // was closed (kill -9, a crash, a power loss) may not open at all (an mp4
-// has no index until it is closed), which is said once per file. `own`:
-// the file this run is about to write.
+// has no index until it is closed), which is said once: a folder resumed
+// after many kills says how many, not a line for each. `own`: the file this
+// run is about to write.
 void check_earlier_overlays(const fs::path& dir, const std::string& own) {
   std::error_code ec;
+  std::vector<std::string> unreadable;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     if (name.rfind("overlay", 0) != 0 || name.rfind(own + ".", 0) == 0 || !it->is_regular_file(ec)) continue;
@@ -117,11 +119,19 @@ void check_earlier_overlays(const fs::path& dir, const std::string& own) {
       cv::Mat first;
       readable = video.isOpened() && video.read(first) && !first.empty();
     }
-    if (readable) continue;
+    if (!readable) unreadable.push_back(it->path().string());
+  }
+  if (unreadable.size() == 1) {
     logger().warn("{}: cannot be read (not closed by the run that wrote it, which was stopped by kill -9, a crash "
                   "or a power loss, or no decoder for it here); the frames it held have no overlay (a run without "
                   "--resume draws them all again)",
-                  it->path().string());
+                  unreadable.front());
+  } else if (unreadable.size() > 1) {
+    std::sort(unreadable.begin(), unreadable.end());
+    logger().warn("{} overlays of earlier runs cannot be read ({} to {}: not closed by the runs that wrote them, "
+                  "which were stopped by kill -9, a crash or a power loss, or no decoder for them here); the frames "
+                  "they held have no overlay (a run without --resume draws them all again)",
+                  unreadable.size(), unreadable.front(), unreadable.back());
   }
 }
 
