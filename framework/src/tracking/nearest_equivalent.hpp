@@ -2,10 +2,10 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <limits>
 
+#include "gtrack/evaluation.hpp"
 #include "gtrack/model.hpp"
 
 namespace gtrack::detail {
@@ -21,10 +21,9 @@ inline Eigen::VectorXd nearest_equivalent(const ArticulatedModel& model, const E
                                           const Eigen::VectorXd& to) {
   Eigen::VectorXd best = h;
   double nearest = std::numeric_limits<double>::infinity();
-  const Eigen::Matrix3d to_rotation_t = rotation_from_euler_deg(to[3], to[4], to[5]).transpose();
   for (int k = 0; k < std::max(1, model.geometry().symmetry_order); ++k) {
     const Eigen::VectorXd e = model.symmetric_equivalent(h, k);
-    const double d = Eigen::AngleAxisd(rotation_from_euler_deg(e[3], e[4], e[5]) * to_rotation_t).angle();
+    const double d = geodesic_angle_deg(e.segment<3>(3), to.segment<3>(3));
     if (d < nearest) {
       nearest = d;
       best = e;
