@@ -41,7 +41,11 @@ TEST(Config, WrongTypeAndRange) {
   EXPECT_NE(e.find("f.toml:2: key 'b'"), std::string::npos) << e;
   EXPECT_NE(e.find("> 0"), std::string::npos) << e;
   e = error_of([&] { t.numbers("c"); });
-  EXPECT_NE(e.find("element 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("f.toml:3: key 'c[1]': expected a number, got a string"), std::string::npos) << e;
+  // An element on its own line is reported at that line.
+  auto rows = gtrack::ConfigTable::parse("r = [\n  [1, 2],\n  [3, \"x\"],\n]\n", "f.toml");
+  e = error_of([&] { rows.number_rows("r", 2); });
+  EXPECT_NE(e.find("f.toml:3: key 'r[1][1]': expected a number"), std::string::npos) << e;
   e = error_of([&] { t.number("missing"); });
   EXPECT_NE(e.find("missing"), std::string::npos) << e;
 }

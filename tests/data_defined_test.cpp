@@ -169,7 +169,7 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   std::string huge = kFourFinger;
   huge.replace(huge.find("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 1e300]");
   const std::string h = config_error(huge);
-  EXPECT_NE(h.find("finger[0].link_lengths_mm': element 2 (1e+300) is out of range; expected a number in (0, 100]"),
+  EXPECT_NE(h.find("finger[0].link_lengths_mm[1]': 1e+300 is out of range; expected a number in (0, 100]"),
             std::string::npos)
       << h;
   std::string far = kFourFinger;

@@ -277,18 +277,36 @@ std::optional<ConfigDifference> first_difference(const ConfigTable& first, const
   return table_difference(a ? *a : empty, b ? *b : empty, first.path());
 }
 
-std::string ConfigTable::where(std::string_view key) const {
+namespace {
+// "file:line: key 'path.key'": where a config error is, as every message starts.
+std::string located(const ConfigTable::Impl& impl, int line, std::string_view key) {
   std::ostringstream s;
+  s << (impl.source.empty() ? std::string("<config>") : impl.source);
+  if (line > 0) s << ":" << line;
+  s << ": ";
+  std::string full = impl.path.empty() ? std::string(key) : impl.path + "." + std::string(key);
+  s << "key '" << shown(full, 60) << "'";
+  return s.str();
+}
+
+// An error in one element of an array: its own line, and its index written as
+// a key path writes an array table's ("distortion[1]", counted from 0).
+[[noreturn]] void fail_element(const ConfigTable::Impl& impl, std::string_view key, const std::string& index,
+                               const toml::node& element, const std::string& message) {
+  int line = static_cast<int>(element.source().begin.line);
+  if (line <= 0) line = impl.line;
+  throw ConfigError(located(impl, line, std::string(key) + index) + ": " + message);
+}
+
+std::string index(size_t i) { return "[" + std::to_string(i) + "]"; }
+}  // namespace
+
+std::string ConfigTable::where(std::string_view key) const {
   int line = impl_->line;
   if (impl_->table) {
     if (auto* n = impl_->table->get(key)) line = static_cast<int>(n->source().begin.line);
   }
-  s << (impl_->source.empty() ? std::string("<config>") : impl_->source);
-  if (line > 0) s << ":" << line;
-  s << ": ";
-  std::string full = impl_->path.empty() ? std::string(key) : impl_->path + "." + std::string(key);
-  s << "key '" << shown(full, 60) << "'";
-  return s.str();
+  return located(*impl_, line, key);
 }
 
 void ConfigTable::fail(std::string_view key, std::string_view message) const {
@@ -438,11 +456,11 @@ std::vector<double> ConfigTable::numbers(std::string_view key, std::optional<siz
   std::vector<double> out;
   for (size_t i = 0; i < arr->size(); ++i) {
     auto v = as_number(*arr->get(i));
-    if (!v) fail(key, "element " + std::to_string(i + 1) + ": expected a number, got " + type_name(*arr->get(i)));
+    if (!v) fail_element(*impl_, key, index(i), *arr->get(i), std::string("expected a number, got ") + type_name(*arr->get(i)));
     if (!in_range(*v, range)) {
       std::ostringstream s;
-      s << "element " << i + 1 << " (" << *v << ") is out of range; expected " << describe_range(range);
-      fail(key, s.str());
+      s << *v << " is out of range; expected " << describe_range(range);
+      fail_element(*impl_, key, index(i), *arr->get(i), s.str());
     }
     out.push_back(*v);
   }
@@ -468,14 +486,13 @@ std::vector<std::vector<double>> ConfigTable::number_rows(std::string_view key, 
   for (size_t i = 0; i < arr->size(); ++i) {
     const toml::array* row = arr->get(i)->as_array();
     if (!row || row->size() != row_size) {
-      fail(key, "element " + std::to_string(i + 1) + ": expected an array of " + std::to_string(row_size) + " numbers");
+      fail_element(*impl_, key, index(i), *arr->get(i), "expected an array of " + std::to_string(row_size) + " numbers");
     }
     std::vector<double> r;
     for (size_t j = 0; j < row->size(); ++j) {
       auto v = as_number(*row->get(j));
       if (!v || !in_range(*v, range)) {
-        fail(key, "element " + std::to_string(i + 1) + "." + std::to_string(j + 1) + ": expected " +
-                      describe_range(range));
+        fail_element(*impl_, key, index(i) + index(j), *row->get(j), "expected " + describe_range(range));
       }
       r.push_back(*v);
     }
@@ -492,7 +509,7 @@ std::vector<std::string> ConfigTable::strings_or(std::string_view key, std::vect
   std::vector<std::string> out;
   for (size_t i = 0; i < arr->size(); ++i) {
     auto v = arr->get(i)->value_exact<std::string>();
-    if (!v) fail(key, "element " + std::to_string(i + 1) + ": expected a string");
+    if (!v) fail_element(*impl_, key, index(i), *arr->get(i), "expected a string");
     out.push_back(*v);
   }
   return out;
@@ -541,7 +558,7 @@ std::vector<ConfigTable> ConfigTable::tables(std::string_view key) const {
   if (!arr) fail(key, std::string("expected an array of tables, got ") + type_name(*n));
   for (size_t i = 0; i < arr->size(); ++i) {
     const toml::table* t = arr->get(i)->as_table();
-    if (!t) fail(key, "element " + std::to_string(i + 1) + ": expected a table");
+    if (!t) fail_element(*impl_, key, index(i), *arr->get(i), "expected a table");
     auto impl = std::make_shared<Impl>();
     impl->root = impl_->root;
     impl->source = impl_->source;
