@@ -15,6 +15,7 @@ class CountsRenderer final : public gtrack::Renderer {
   std::vector<gtrack::PairCounts> counts;
   std::uint64_t observed = 0;
   int submitted = 0, finished = 0;
+  bool fail_submit = false, fail_finish = false;
   std::string name() const override { return "counts"; }
   void set_model(const gtrack::ArticulatedModel&) override {}
   void set_projection(const gtrack::Projection&, double) override {}
@@ -23,11 +24,13 @@ class CountsRenderer final : public gtrack::Renderer {
   void set_rim(const cv::Mat&) override {}
   std::uint64_t observation_count() const override { return observed; }
   void submit(const Eigen::MatrixXd& h) override {
+    if (fail_submit) throw gtrack::Error("counts: no model");
     ++submitted;
     n_ = static_cast<int>(h.cols());
   }
   void finish(std::vector<gtrack::PairCounts>& out) override {
     ++finished;
+    if (fail_finish) throw gtrack::Error("counts: lost the device");
     out.assign(counts.begin(), counts.begin() + n_);
   }
   cv::Mat render_mask(const Eigen::VectorXd&) override { return {}; }
@@ -90,6 +93,28 @@ TEST(Cost, APluginErrorDuringABatchLeavesNoBatchPending) {
   s.fail = false;
   eval.evaluate(h, t);
   EXPECT_EQ(t.size(), 2u);
+}
+
+// A renderer's own error, in submit() or finish(), leaves no other view's
+// batch pending: a view started before it is still collected, so that the
+// next evaluation is taken once the cause is gone.
+TEST(Cost, ARenderersErrorLeavesNoOtherViewsBatchPending) {
+  FixedGripper g;
+  const Eigen::MatrixXd h = Eigen::MatrixXd::Zero(8, 2);
+  std::vector<gtrack::CostTerms> t;
+  for (const bool in_finish : {false, true}) {
+    SCOPED_TRACE(in_finish ? "finish() throws" : "submit() throws");
+    CountsRenderer a, b, c;
+    a.counts = b.counts = c.counts = {{10, 10}, {10, 10}};
+    gtrack::CostEvaluator eval({&a, &b, &c}, g, nullptr, gtrack::CostWeights{});
+    (in_finish ? a.fail_finish : b.fail_submit) = true;
+    EXPECT_THROW(eval.evaluate(h, t), gtrack::Error);
+    for (const CountsRenderer* r : {&a, &b, &c}) EXPECT_EQ(r->finished, r->submitted);
+    a.fail_finish = b.fail_submit = false;
+    eval.evaluate(h, t);
+    EXPECT_EQ(t.size(), 2u);
+    for (const CountsRenderer* r : {&a, &b, &c}) EXPECT_EQ(r->finished, r->submitted);
+  }
 }
 
 // A gripper plugin's K that is no number is its error, named, not a cost

@@ -169,9 +169,22 @@ TEST(DataDefinedGripper, MistakesAreLocated) {
   std::string huge = kFourFinger;
   huge.replace(huge.find("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 1e300]");
   const std::string h = config_error(huge);
-  EXPECT_NE(h.find("finger[0].link_lengths_mm[1]': 1e+300 is out of range; expected a number in (0, 100]"),
+  EXPECT_NE(h.find("finger[0].link_lengths_mm[1]': value 1e+300 is out of range; expected a number in [0.001, 100]"),
             std::string::npos)
       << h;
+  // Sizes with no area at any render size: refused, not a gripper of its
+  // palm alone, or a palm with no area blamed on another key.
+  std::string tiny = kFourFinger;
+  tiny.replace(tiny.find("link_lengths_mm = [0.3, 0.3]"), 28, "link_lengths_mm = [0.3, 1e-300]");
+  EXPECT_NE(config_error(tiny).find("finger[0].link_lengths_mm[1]': value 1e-300 is out of range"), std::string::npos)
+      << config_error(tiny);
+  const std::string radial = "plugin = \"data_defined\"\n[radial]\nfingers = 4\npalm_circumradius_mm = 0.5\n"
+                             "link_lengths_mm = [0.4]\nlink_widths_mm = [0.4, 0]\n";
+  const std::string speck = with(radial, "palm_circumradius_mm = 0.5", "palm_circumradius_mm = 1e-300");
+  EXPECT_NE(config_error(speck).find("key 'radial.palm_circumradius_mm': value 1e-300 is out of range"), std::string::npos)
+      << config_error(speck);
+  const std::string spun = radial + "phase_deg = 1e17\n";
+  EXPECT_NE(config_error(spun).find("key 'radial.phase_deg'"), std::string::npos) << config_error(spun);
   std::string far = kFourFinger;
   far.replace(far.find("base_mm = [0.2, 0.2]"), 20, "base_mm = [0.2, 500]");
   EXPECT_NE(config_error(far).find("finger[0].base_mm"), std::string::npos) << config_error(far);

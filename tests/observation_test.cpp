@@ -28,6 +28,25 @@ TEST(Observation, HsvBoundsOpeningAndDownscale) {
   EXPECT_EQ(obs.mask.at<uchar>(15, 15), 255);
 }
 
+// The downscale's threshold is the share of a render pixel's area that must
+// be observed: the smallest shares take any area at all, never the whole
+// image (a share under 0.5/255 had set every pixel).
+TEST(Observation, ASmallDownscaleThresholdTakesAnyAreaNotTheWholeImage) {
+  cv::Mat img = grey_frame();
+  cv::rectangle(img, cv::Rect(40, 40, 41, 41), cv::Scalar(40, 40, 200), cv::FILLED);
+  for (const double share : {0.5, 0.01, 0.001, 1e-9}) {
+    SCOPED_TRACE(share);
+    gtrack::ObservationConfig c;
+    c.downscale_threshold = share;
+    gtrack::Segmenter seg(c, {200, 200}, {50, 50});
+    const auto obs = seg.observe(img);
+    // The square's 41 px span 10.25 render pixels: 10 whole, and up to two
+    // partly covered rows and columns.
+    EXPECT_GE(obs.count, 100u);
+    EXPECT_LE(obs.count, 144u);
+  }
+}
+
 TEST(Observation, HueBoundsSelectAColour) {
   cv::Mat img = grey_frame();
   cv::rectangle(img, {10, 10, 40, 40}, cv::Scalar(200, 40, 40), cv::FILLED);  // blue: H ~ 120

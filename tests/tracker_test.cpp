@@ -1088,6 +1088,36 @@ TEST(Tracker, TiltMarginIsWideForAFoldedGripperAndNarrowForAFlatOne) {
   EXPECT_EQ(where & corner, where) << where;  // nothing else drawn
 }
 
+// The overlay's outline lies where the renderers put the model: its filled
+// area's centre is the rendered mask's, within a quarter of a pixel
+// (measured: 0.13 px, the anti-aliased outline's share on this small image).
+// It had been drawn half a pixel down and right (0.58 and 0.42 px), OpenCV's
+// pixel centres being on integers and gtrack's at +0.5.
+TEST(Tracker, TheOverlayIsDrawnWhereTheModelIsRendered) {
+  auto setup = make_setup();
+  const Eigen::VectorXd h = pose(0.3, -0.2, 20, 30);
+  gtrack::RenderOptions ro;
+  ro.backend = "cpu";
+  ro.scale = 1.0;
+  auto r = gtrack::make_cpu_renderer(ro);
+  r->set_model(setup.model());
+  r->set_projection(setup.sensor->projection(), 1.0);
+  const cv::Mat mask = r->render_mask(h);
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  gtrack::Estimate e;
+  e.hypothesis = h;
+  const cv::Mat black(mask.size(), CV_8UC3, cv::Scalar::all(0));
+  cv::Mat drawn;
+  cv::extractChannel(tracker.draw_overlay(black, e), drawn, 1);  // green
+  drawn(cv::Rect(0, 0, drawn.cols, drawn.rows / 8)).setTo(0);    // the reading's text
+  drawn(cv::Rect(0, drawn.rows * 7 / 8, drawn.cols, drawn.rows / 8)).setTo(0);
+  const cv::Moments m = cv::moments(mask, true), o = cv::moments(drawn, false);
+  ASSERT_GT(m.m00, 100);
+  ASSERT_GT(o.m00, 0);
+  EXPECT_NEAR(o.m10 / o.m00, m.m10 / m.m00, 0.25);
+  EXPECT_NEAR(o.m01 / o.m00, m.m01 / m.m00, 0.25);
+}
+
 // The turned tilt of re-detection's searches: the Euler pair (rx, ry)
 // turned in its plane, the rest of the configuration unchanged; 180 deg is
 // the mirror.
@@ -1286,6 +1316,27 @@ TEST(EngineConfig, ExcludedRectanglesAreWholePixelsWithinTheImage) {
                 .find("expected [x, y, width, height] in whole pixels, width and height at least 1, within the "
                       "256x256 image"),
             std::string::npos);
+}
+
+// Values inside a key's old range that broke the track without a word: a
+// sigma whose square underflows (costs of nan on frames said ok), a margin
+// past an int (every frame after the first lost), weights that overflow the
+// tables. Each is refused naming its key and the range.
+TEST(EngineConfig, ValuesThatWouldBreakTheCostOrTheSearchBoxAreRefused) {
+  for (const auto& [extra, said] : std::vector<std::pair<std::string, std::string>>{
+           {"[cost]\ncoherence_sigma_deg = 1e-300\n", "key 'cost.coherence_sigma_deg'"},
+           {"[cost]\ntemporal_joint_sigma_deg = 1e-9\n", "expected 0 (the joints left out) or a number in [0.01, 180]"},
+           {"[cost]\nlambda_dice = 1e308\n", "key 'cost.lambda_dice'"},
+           {"[cost]\nlambda_temporal = 1e7\n", "key 'cost.lambda_temporal'"},
+           {"[observation]\nroi_margin_px = 2.2e9\n", "key 'observation.roi_margin_px'"},
+           {"[pso]\nc = 1e300\n", "key 'pso.c'"},
+           {"[tracker]\ninit_spread = [0.1, 0.1, 1e-300, 10, 10, 10, 10]\n", "value 1e-300 for z is out of range"},
+           {"[tracker]\ninit_spread = [0.1, 0.1, 0.1, 10, 10, 1e9, 10]\n", "key 'tracker.init_spread[5]'"}}) {
+    const std::string m = engine_config_error(extra);
+    EXPECT_NE(m.find(said), std::string::npos) << extra << m;
+  }
+  EXPECT_NO_THROW(gtrack::engine_config(make_setup("[cost]\ntemporal_joint_sigma_deg = 0\n")));
+  EXPECT_NO_THROW(gtrack::engine_config(make_setup("[tracker]\ninit_spread = [0.1, 0.1, 0, 10, 10, 10, 0]\n")));
 }
 
 // [render] egl_device's form is checked with the config, naming its key:

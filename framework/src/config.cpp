@@ -459,7 +459,7 @@ std::vector<double> ConfigTable::numbers(std::string_view key, std::optional<siz
     if (!v) fail_element(*impl_, key, index(i), *arr->get(i), std::string("expected a number, got ") + type_name(*arr->get(i)));
     if (!in_range(*v, range)) {
       std::ostringstream s;
-      s << *v << " is out of range; expected " << describe_range(range);
+      s << "value " << *v << " is out of range; expected " << describe_range(range);
       fail_element(*impl_, key, index(i), *arr->get(i), s.str());
     }
     out.push_back(*v);

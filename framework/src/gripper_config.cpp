@@ -34,7 +34,7 @@ GripperGeometry radial_gripper_from_config(const ConfigTable& t, RadialGripperDe
                 " (RadialGripperDefaults::widths_mm: the width at each hinge and at the tip)");
   }
   RadialGripperSpec spec = d.spec;
-  const Range size{0.0, ArticulatedModel::kMaxSizeMm, true, false};
+  const Range size = Range::closed(ArticulatedModel::kMinSizeMm, ArticulatedModel::kMaxSizeMm);
   spec.palm_circumradius_mm = t.number_or("palm_circumradius_mm", spec.palm_circumradius_mm, size);
   std::vector<double> lengths;
   for (const auto& l : spec.links) lengths.push_back(l.length_mm);

@@ -72,6 +72,9 @@ class GTRACK_API ArticulatedModel {
   // model past either is refused by the constructor.
   static constexpr int kMaxLinks = 255;
   static constexpr double kMaxSizeMm = 100;
+  // The least length of a link and radius of a palm a config may give (1 um):
+  // less has no area at any render size.
+  static constexpr double kMinSizeMm = 0.001;
 
   ArticulatedModel() = default;
   // Validates the geometry; throws gtrack::Error saying what is wrong.

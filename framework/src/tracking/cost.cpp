@@ -78,9 +78,21 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
   const int n = static_cast<int>(hypotheses.cols());
   out.assign(n, CostTerms{});
   for (auto& t : out) t.dice = t.dice_without_rim = 0;
-  // Every renderer starts its batch first; K and S are computed while they work.
-  for (Renderer* r : renderers_) r->submit(hypotheses);
+  // Every renderer started takes its batch's finish() whatever fails after
+  // (a renderer's own error, a plugin's), so that it can take the next batch.
+  size_t pending_from = 0, pending_to = 0;
+  const auto collect_pending = [&] {
+    for (; pending_from < pending_to; ++pending_from) {
+      try {
+        renderers_[pending_from]->finish(counts_);
+      } catch (...) {
+        // The first error is the one to report.
+      }
+    }
+  };
   try {
+    // Every renderer starts its batch first; K and S are computed while they work.
+    for (; pending_to < renderers_.size(); ++pending_to) renderers_[pending_to]->submit(hypotheses);
     for (int i = 0; i < n; ++i) {
       const int joints = static_cast<int>(hypotheses.rows()) - kPoseDims;
       std::span<const double> q(hypotheses.col(i).data() + kPoseDims, joints);
@@ -113,20 +125,21 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
                             : 0.0;
     }
   } catch (...) {
-    // A plugin's error (a stimulus's unusable penalty): the batches are
-    // collected all the same, so that the renderers can take the next one.
-    for (Renderer* r : renderers_) {
-      try {
-        r->finish(counts_);
-      } catch (...) {
-        // The plugin's error is the one to report.
-      }
-    }
+    collect_pending();
     throw;
   }
-  for (Renderer* r : renderers_) {
-    r->finish(counts_);
+  for (; pending_from < pending_to; ++pending_from) {
+    Renderer* r = renderers_[pending_from];
+    try {
+      r->finish(counts_);
+    } catch (...) {
+      ++pending_from;
+      collect_pending();
+      throw;
+    }
     if (static_cast<int>(counts_.size()) != n) {
+      ++pending_from;
+      collect_pending();
       throw Error("renderer '" + r->name() + "' returned " + std::to_string(counts_.size()) + " counts for " +
                   std::to_string(n) + " hypotheses");
     }
@@ -152,6 +165,14 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
     t.dice_without_rim /= views;
     t.total = weights_.dice * t.dice + weights_.kinematic * t.kinematic + weights_.stimulus * t.stimulus +
               weights_.temporal * t.temporal + weights_.coherence * t.coherence;
+    // The plugins' terms are checked where they are made; this is the
+    // engine's own (a temporal scale so small that any change is infinite).
+    if (!std::isfinite(t.total)) {
+      throw Error(fmt::format("cost: a hypothesis's cost is {} (D {}, K {}, S {}, T {}, C {}); expected a finite "
+                              "number: check the [cost] weights and the [tracker] init_spread the temporal term "
+                              "scales by",
+                              t.total, t.dice, t.kinematic, t.stimulus, t.temporal, t.coherence));
+    }
   }
   evaluations_ += n;
 }

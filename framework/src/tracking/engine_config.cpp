@@ -35,7 +35,7 @@ ObservationConfig read_observation(const ConfigTable& t, const Sensor& sensor) {
   o.downscale_threshold =
       t.number_or("downscale_threshold", o.downscale_threshold, {0.0, 1.0, true, false});
   o.roi = t.boolean_or("roi", o.roi);
-  o.roi_margin_px = t.number_or("roi_margin_px", o.roi_margin_px, Range::non_negative());
+  o.roi_margin_px = t.number_or("roi_margin_px", o.roi_margin_px, Range::closed(0, 65536));
   o.prior = t.boolean_or("prior", o.prior);
   o.prior_sigma_px = t.number_or("prior_sigma_px", o.prior_sigma_px, Range::positive());
   o.prior_threshold = t.number_or("prior_threshold", o.prior_threshold, {0.0, 1.0, true, true});
@@ -63,7 +63,7 @@ PsoConfig read_pso(const ConfigTable& t) {
   p.particles = static_cast<int>(t.integer_or("particles", p.particles, Range::closed(2, 1 << 16)));
   p.generations = static_cast<int>(t.integer_or("generations", p.generations, Range::closed(1, 1 << 16)));
   p.inertia = t.number_or("inertia", p.inertia, Range::closed(0, 1.5));
-  p.c = t.number_or("c", p.c, Range::non_negative());
+  p.c = t.number_or("c", p.c, Range::closed(0, 10));
   p.randomize_every = static_cast<int>(t.integer_or("randomize_every", p.randomize_every, Range::non_negative()));
   p.randomize_fraction = t.number_or("randomize_fraction", p.randomize_fraction, {0.0, 1.0, true, false});
   p.max_velocity_fraction = t.number_or("max_velocity_fraction", p.max_velocity_fraction, Range::non_negative());
@@ -73,14 +73,22 @@ PsoConfig read_pso(const ConfigTable& t) {
 
 CostWeights read_cost(const ConfigTable& t) {
   CostWeights c;
-  c.dice = t.number_or("lambda_dice", c.dice, Range::positive());  // 0: the image would not count
-  c.kinematic = t.number_or("lambda_kinematic", c.kinematic, Range::non_negative());
-  c.stimulus = t.number_or("lambda_stimulus", c.stimulus, Range::non_negative());
-  c.temporal = t.number_or("lambda_temporal", c.temporal, Range::non_negative());
+  // Weights past 1e6 make the terms' sum overflow what the tables can show;
+  // a sigma under 0.01 deg makes a term of any change infinite.
+  const Range weight = Range::closed(0, 1e6);
+  c.dice = t.number_or("lambda_dice", c.dice, {0.0, 1e6, true, false});  // 0: the image would not count
+  c.kinematic = t.number_or("lambda_kinematic", c.kinematic, weight);
+  c.stimulus = t.number_or("lambda_stimulus", c.stimulus, weight);
+  c.temporal = t.number_or("lambda_temporal", c.temporal, weight);
   c.temporal_joint_sigma_deg =
       t.number_or("temporal_joint_sigma_deg", c.temporal_joint_sigma_deg, Range::closed(0.0, 180.0));
-  c.coherence = t.number_or("lambda_coherence", c.coherence, Range::non_negative());
-  c.coherence_sigma_deg = t.number_or("coherence_sigma_deg", c.coherence_sigma_deg, {0.0, 180.0, true, false});
+  if (c.temporal_joint_sigma_deg > 0 && c.temporal_joint_sigma_deg < 0.01) {
+    t.fail("temporal_joint_sigma_deg", fmt::format("value {:g} is out of range; expected 0 (the joints left out) or a "
+                                                   "number in [0.01, 180]",
+                                                   c.temporal_joint_sigma_deg));
+  }
+  c.coherence = t.number_or("lambda_coherence", c.coherence, weight);
+  c.coherence_sigma_deg = t.number_or("coherence_sigma_deg", c.coherence_sigma_deg, Range::closed(0.01, 180.0));
   c.occlusion_discount = t.number_or("occlusion_discount", c.occlusion_discount, Range::closed(0.0, 1.0));
   c.occlusion_budget = t.number_or("occlusion_budget", c.occlusion_budget, Range::closed(0.0, 4.0));
   c.occlusion_tolerance = t.number_or("occlusion_tolerance", c.occlusion_tolerance, Range::closed(0.0, 1.0));
@@ -229,8 +237,18 @@ TrackerConfig read_tracker(const ConfigTable& t, const ArticulatedModel& model, 
   // quarter of the in-plane spread, so that a flat cost in depth does not
   // let it random-walk from frame to frame.
   const std::vector<double> spread_default = {0.1 * r, 0.1 * r, 0.025 * r, 10, 10, 10, 10};
-  const auto spread = t.numbers_or("init_spread", spread_default, 7, Range::non_negative());
-  for (int i = 0; i < 7; ++i) c.init_spread[i] = spread[i];
+  const auto spread = t.numbers_or("init_spread", spread_default, 7, Range::closed(0, 360));
+  // A spread so small that the temporal term, which it scales, makes any
+  // change infinite: 0 (held) or at least 0.1 um and 0.001 deg.
+  static const char* const kSpreadNames[7] = {"x", "y", "z", "rx", "ry", "rz", "the joints"};
+  for (int i = 0; i < 7; ++i) {
+    const double least = i < 3 ? 1e-4 : 1e-3;
+    if (spread[i] > 0 && spread[i] < least) {
+      t.fail("init_spread", fmt::format("value {:g} for {} is out of range; expected 0 or at least {:g} {}", spread[i],
+                                        kSpreadNames[i], least, i < 3 ? "mm" : "deg"));
+    }
+    c.init_spread[i] = spread[i];
+  }
   const auto pose = t.numbers_or("initial_pose", {});
   if (!pose.empty()) {
     if (static_cast<int>(pose.size()) != model.dims()) {

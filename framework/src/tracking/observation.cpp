@@ -1,6 +1,7 @@
 // Segmentation into the observation O, with the temporal prior (paper 2.1, 3).
 #include "gtrack/observation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -70,9 +71,12 @@ Observation Segmenter::observe(const cv::Mat& frame, const ObservationPrior* pri
   if (have_prior && config_.roi) {
     const cv::Rect box = cv::boundingRect(prior->previous_mask);
     const double m = config_.roi_margin_px * widen;
-    const int x0 = static_cast<int>(std::floor(box.x / sx - m)), y0 = static_cast<int>(std::floor(box.y / sy - m));
-    const int x1 = static_cast<int>(std::ceil((box.x + box.width) / sx + m));
-    const int y1 = static_cast<int>(std::ceil((box.y + box.height) / sy + m));
+    // Clamped to the image before the cast: a wide margin, widened by lost
+    // frames, is the whole image, not an int's overflow.
+    const auto at = [](double v, int side) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(side))); };
+    const int x0 = at(std::floor(box.x / sx - m), image_.width), y0 = at(std::floor(box.y / sy - m), image_.height);
+    const int x1 = at(std::ceil((box.x + box.width) / sx + m), image_.width);
+    const int y1 = at(std::ceil((box.y + box.height) / sy + m), image_.height);
     obs.roi = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, image_.width, image_.height);
   }
   const cv::Mat full = segment(frame, obs.roi);
@@ -83,7 +87,9 @@ Observation Segmenter::observe(const cv::Mat& frame, const ObservationPrior* pri
     cv::Mat small;
     cv::resize(full, small, cv::Size(render_.width, render_.height), 0, 0, cv::INTER_AREA);
     // INTER_AREA averages: a render pixel is set when enough of its area is.
-    cv::threshold(small, obs.mask, config_.downscale_threshold * 255.0 - 0.5, 255, cv::THRESH_BINARY);
+    // Any area at all is the limit of a small threshold: a negative one
+    // would set every pixel.
+    cv::threshold(small, obs.mask, std::max(0.0, config_.downscale_threshold * 255.0 - 0.5), 255, cv::THRESH_BINARY);
   }
   obs.detected = static_cast<std::uint64_t>(cv::countNonZero(obs.mask));
 

@@ -67,7 +67,8 @@ cv::Mat draw_estimate(const cv::Mat& frame, const Sensor& sensor, const Articula
       for (size_t k = 0; k < 3; ++k) {
         const auto p = sensor.project(tris[i + k]);
         if (!p) break;
-        poly.emplace_back(cvRound(p->x() * (1 << shift)), cvRound(p->y() * (1 << shift)));
+        // project() puts pixel centres at +0.5, OpenCV's drawing on integers.
+        poly.emplace_back(cvRound((p->x() - 0.5) * (1 << shift)), cvRound((p->y() - 0.5) * (1 << shift)));
       }
       if (poly.size() != 3) continue;
       cv::fillConvexPoly(fill, poly, 255, cv::LINE_AA, shift);

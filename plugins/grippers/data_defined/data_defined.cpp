@@ -27,7 +27,7 @@ using gtrack::ConfigTable;
 using gtrack::Range;
 
 constexpr double kMaxMm = gtrack::ArticulatedModel::kMaxSizeMm;
-const Range kLength{0.0, kMaxMm, true, false};  // (0, 100] mm
+const Range kLength = Range::closed(gtrack::ArticulatedModel::kMinSizeMm, kMaxMm);  // [0.001, 100] mm
 const Range kPlace = Range::closed(-kMaxMm, kMaxMm);
 
 std::vector<gtrack::LinkShape> read_links(const ConfigTable& t) {
@@ -81,7 +81,7 @@ gtrack::GripperGeometry read_geometry(const ConfigTable& t) {
     spec.palm_sides = static_cast<int>(r.integer_or("palm_sides", sides, Range{3, 256}));
     if (spec.palm_sides % spec.fingers != 0) r.fail("palm_sides", "must be a multiple of fingers");
     spec.palm_circumradius_mm = r.number("palm_circumradius_mm", kLength);
-    spec.finger_phase_deg = r.number_or("phase_deg", 0.0);
+    spec.finger_phase_deg = r.number_or("phase_deg", 0.0, Range::closed(-360, 360));
     spec.links = read_links(r);
     r.check_all_used();
     g = gtrack::make_radial_gripper(spec);
