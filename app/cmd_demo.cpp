@@ -25,7 +25,9 @@ int run_demo(const gtrack::cli::CommonOptions& common, const po::variables_map& 
   so.frames = vm["frames"].as<int>();
   so.seed = gtrack::cli::seed_option(vm);
   so.preset = vm["preset"].as<std::string>();
-  if (so.frames < 2) throw gtrack::cli::UsageError("--frames must be at least 2");
+  if (so.frames < 2 || so.frames > gtrack::cli::kMaxSynthFrames) {
+    throw gtrack::cli::UsageError("--frames must be from 2 to " + std::to_string(gtrack::cli::kMaxSynthFrames));
+  }
   const gtrack::SynthPreset& preset = gtrack::synth_preset(so.preset);
   const fs::path config = gtrack::data_dir() / "configs" / preset.config;
   if (!fs::is_regular_file(config)) {

@@ -217,7 +217,10 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   c.synth.seed = gtrack::cli::seed_option(vm);
   c.synth.preset = vm["preset"].as<std::string>();
   c.sequences = vm["sequences"].as<int>();
-  if (c.synth.frames < 2 || c.sequences < 1) throw gtrack::cli::UsageError("--frames >= 2 and --sequences >= 1");
+  if (c.synth.frames < 2 || c.synth.frames > gtrack::cli::kMaxSynthFrames) {
+    throw gtrack::cli::UsageError("--frames must be from 2 to " + std::to_string(gtrack::cli::kMaxSynthFrames));
+  }
+  if (c.sequences < 1 || c.sequences > 1000) throw gtrack::cli::UsageError("--sequences must be from 1 to 1000");
   c.config = vm.count("config") ? fs::path(vm["config"].as<std::string>())
                                 : gtrack::data_dir() / "configs" / gtrack::synth_preset(c.synth.preset).config;
   {
@@ -245,11 +248,13 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
       }
     }
   };
-  check(particles, 2, 100000, true, "particles", "whole numbers");
-  check(generations, 1, 100000, true, "generations", "whole numbers");
+  // The bounds of [pso] particles and generations.
+  check(particles, 2, 65536, true, "particles", "whole numbers");
+  check(generations, 1, 65536, true, "generations", "whole numbers");
   check(sigmas, 0, 90, false, "sigmas", "degrees");
-  if (vm["fig6b-particles"].as<int>() < 2) throw gtrack::cli::UsageError("--fig6b-particles must be at least 2");
-  if (vm["fig6b-generations"].as<int>() < 1) throw gtrack::cli::UsageError("--fig6b-generations must be at least 1");
+  check({static_cast<double>(vm["fig6b-particles"].as<int>())}, 2, 65536, true, "fig6b-particles", "a whole number");
+  check({static_cast<double>(vm["fig6b-generations"].as<int>())}, 1, 65536, true, "fig6b-generations",
+        "a whole number");
   // The config is checked, as track checks it, before anything is made:
   // its errors name the user's file, not a sequence made from it.
   {

@@ -37,7 +37,9 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
     }
   }
   if (o.threads < 0) throw gtrack::cli::UsageError("--threads must be 0 (all cores) or more");
-  if (o.frames < 1) throw gtrack::cli::UsageError("--frames must be at least 1");
+  if (o.frames < 1 || o.frames > gtrack::cli::kMaxSynthFrames) {
+    throw gtrack::cli::UsageError("--frames must be from 1 to " + std::to_string(gtrack::cli::kMaxSynthFrames));
+  }
   if (!(o.joint_noise_deg >= 0 && o.joint_noise_deg <= 90)) {
     throw gtrack::cli::UsageError("--joint-noise must be a number of degrees in [0, 90]");
   }

@@ -86,7 +86,13 @@ void set_stream_apart() {
 }
 
 int run_track(const gtrack::cli::CommonOptions& common, const po::variables_map& vm) {
-  if (vm.count("stream")) set_stream_apart();
+  if (vm.count("stream")) {
+    if (common.stdout_closed) {
+      throw gtrack::cli::UsageError("--stream: stdout is closed; expected it open to the estimates' reader (a pipe, a "
+                                    "file)");
+    }
+    set_stream_apart();
+  }
   gtrack::SetupOptions so;
   so.plugin_paths = common.plugin_paths;
   gtrack::Setup setup = gtrack::load_setup(vm["config"].as<std::string>(), so);

@@ -26,9 +26,15 @@
 
 namespace gtrack::cli {
 
+// The most frames a synthetic sequence has (synth, sweep, demo): nine hours
+// at 30 frames/s; more is a typing slip, which would fill the memory and
+// the disk before a word.
+constexpr int kMaxSynthFrames = 1000000;
+
 struct CommonOptions {
   std::vector<std::filesystem::path> plugin_paths;  // from --plugin-path, in order
   std::string log_level = "info";
+  bool stdout_closed = false;  // the caller had closed stdout (`>&-`); it is /dev/null now
 };
 
 struct Command {

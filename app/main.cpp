@@ -28,6 +28,8 @@ std::vector<Command>& registry() {
 
 namespace {
 
+bool g_stdout_closed = false;
+
 po::options_description common_options() {
   po::options_description d("Common options");
   d.add_options()("help,h", "show this help")("version", "print the version and exit")(
@@ -152,6 +154,7 @@ int run(int argc, char** argv) {
 
   gtrack::cli::CommonOptions common;
   common.log_level = vm["log-level"].as<std::string>();
+  common.stdout_closed = g_stdout_closed;
   try {
     gtrack::set_log_level(common.log_level);
   } catch (const gtrack::Error& e) {
@@ -170,7 +173,9 @@ int main(int argc, char** argv) {
   // otherwise the first file opened would take its number, and what is
   // printed would be written into it.
   for (int fd = 0; fd <= 2; ++fd) {
-    if (::fcntl(fd, F_GETFD) == -1 && ::open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) != fd) return 1;
+    if (::fcntl(fd, F_GETFD) != -1) continue;
+    if (::open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) != fd) return 1;
+    if (fd == STDOUT_FILENO) g_stdout_closed = true;
   }
   try {
     std::vector<char*> args = command_first(argc, argv);

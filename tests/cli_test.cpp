@@ -255,16 +255,26 @@ TEST(Cli, StreamReaderGoingAwayStopsTheRunCleanly) {
   EXPECT_NE(read_file(err).find("stdout was closed by its reader; stopped after 1 frame,"), std::string::npos)
       << read_file(err);
 
-  // stdout closed before the run (`>&-`): the lines go nowhere, not into the
-  // first file opened, which would take stdout's number.
+  // stdout closed before the run (`>&-`): what is printed goes nowhere, not
+  // into the first file opened, which would take stdout's number.
   const CliRun closed = gtrack(track_of(dir) + " --frames 0:2 -o " + (dir / "out_closed").string() +
-                                   " --no-overlay --stream",
+                                   " --no-overlay --log-level warn",
                                ">&- 2>/dev/null");
   EXPECT_EQ(closed.code, 0);
   for (const char* file : {"estimates.csv", "run_config.toml", "tracker_state.txt"}) {
-    EXPECT_EQ(read_file(dir / "out_closed" / file).find("{\"frame\""), std::string::npos) << file;
+    EXPECT_EQ(read_file(dir / "out_closed" / file).find("frames (0 lost)"), std::string::npos) << file;
   }
   EXPECT_EQ(read_file(dir / "out_closed" / "estimates.csv").rfind("frame,x_mm", 0), 0u);
+  // With --stream the estimates would go nowhere: refused, before anything
+  // is tracked.
+  const CliRun streamed = gtrack(track_of(dir) + " --frames 0:2 -o " + (dir / "out_closed_stream").string() +
+                                     " --no-overlay --stream",
+                                 "2>&1 >&-");
+  EXPECT_EQ(streamed.code, 2) << streamed.output;
+  EXPECT_NE(streamed.output.find("--stream: stdout is closed; expected it open to the estimates' reader"),
+            std::string::npos)
+      << streamed.output;
+  EXPECT_FALSE(fs::exists(dir / "out_closed_stream" / "estimates.csv"));
 }
 
 // A renderer that cannot start says so at once, not once a followed
@@ -404,6 +414,12 @@ TEST(Cli, TrackRefusesALogOnAnotherClockOrInAnotherUnit) {
                                    "'temperature_hysteresis' reads C"),
             std::string::npos)
       << fahrenheit.output;
+  // The unit is said first, before a reading that only the unit puts
+  // outside what the plugin takes (a hot bath in F): widening the plugin's
+  // range would be the wrong mend.
+  const CliRun hot = track_with("hot.csv", "time_s,T_F\n0.0,71.6\n1.0,1000\n");
+  EXPECT_EQ(hot.code, 1) << hot.output;
+  EXPECT_NE(hot.output.find("hot.csv: its readings' column 'T_F' says F"), std::string::npos) << hot.output;
   // A log that ends before the frames (a logger stopped early) is not
   // refused: each frame past it holds the last reading, as said.
   const CliRun early = track_with("early.csv", "time_s,T_C\n-2.0,22\n-1.0,23\n");

@@ -432,6 +432,32 @@ TEST(Fault, AnInputThatFailsAtOnceLeavesTheEarlierRun) {
   EXPECT_EQ(read_text(o.out_dir / "summary.json"), summary);
 }
 
+// A resume that finds every frame done keeps a finished run's summary, and
+// replaces one that says the run was stopped (a two-pass run interrupted
+// in its backward pass has its forward frames all done): it had gone on
+// saying cancelled after the resume completed the run.
+TEST(Fault, AResumeWithNothingLeftKeepsAFinishedSummaryAndMendsAStoppedOne) {
+  const fs::path dir = fresh_dir("resume_nothing_left");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, kFrames);
+  gtrack::track_sequence(r.setup, r.config, o);
+  const fs::path file = o.out_dir / "summary.json";
+  const std::string finished = read_text(file);
+  gtrack::TrackOptions again = o;
+  again.resume = true;
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, again).frames, 0);
+  EXPECT_EQ(read_text(file), finished);
+  std::string stopped = finished;
+  const std::string no = "\"cancelled\": false", yes = "\"cancelled\": true";
+  ASSERT_NE(stopped.find(no), std::string::npos) << stopped;
+  stopped.replace(stopped.find(no), no.size(), yes);
+  std::ofstream(file, std::ios::trunc) << stopped;
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, again).frames, 0);
+  const std::string mended = read_text(file);
+  EXPECT_NE(mended.find(no), std::string::npos) << mended;
+  EXPECT_NE(mended.find("\"resumed_after_frame\": " + std::to_string(kFrames - 1) + ","), std::string::npos) << mended;
+}
+
 // A file the run cannot write is named as the run's file, not its
 // stand-in (FILE.tmp, renamed over it), with the system's reason; the
 // frames before are kept.

@@ -144,6 +144,10 @@ TEST(StimulusLog, ALoggersNamedColumnsAreReadByName) {
   EXPECT_EQ(error(channels, ""), "log.csv:1: the log has the columns 'B_mT', 'T_C'; say which holds the readings "
                                  "(--stimulus-column NAME)");
   EXPECT_EQ(error(channels, "T_F"), "log.csv:1: no column 'T_F'; the log has 'B_mT', 'T_C'");
+  // Two probes logged under one name: which is the reading is not guessed.
+  EXPECT_EQ(error("time_s,T_C,T_C\n0,22,23\n", "T_C"),
+            "log.csv:1: the column 'T_C' appears twice ('T_C', 'T_C'); expected one column of that name, the "
+            "readings'");
   EXPECT_EQ(error("time_s,B_mT,T_C\n0,2.5\n", "T_C"), "log.csv:2: expected 3 fields, as the header has, got '0,2.5'");
   EXPECT_EQ(error("time_s,B_mT,T_C\n0,2.5,hot\n", "T_C"), "log.csv:2: expected a number in the 'T_C' field, got 'hot'");
 }

@@ -141,6 +141,10 @@ void StimulusLog::take_line(std::string line) {
     }
     const auto at = column_.empty() ? fields.begin() + 1 : std::find(fields.begin() + 1, fields.end(), column_);
     if (at == fields.end()) throw InputError(where + "no column " + field_text(column_) + "; the log has " + names);
+    if (!column_.empty() && std::find(at + 1, fields.end(), column_) != fields.end()) {
+      throw InputError(where + "the column " + field_text(column_) + " appears twice (" + names +
+                       "); expected one column of that name, the readings'");
+    }
     key_ = fields[0] == "frame" ? Key::Frame : Key::Time;
     value_field_ = static_cast<size_t>(at - fields.begin());
     field_count_ = fields.size();

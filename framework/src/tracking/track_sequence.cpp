@@ -22,6 +22,7 @@
 #include "gtrack/results.hpp"
 #include "gtrack/sequence_io.hpp"
 #include "gtrack/stimulus_log.hpp"
+#include "gtrack/text_file.hpp"
 #include "gtrack/tracker.hpp"
 #include "captured_stderr.hpp"
 #include "dicom.hpp"
@@ -268,6 +269,18 @@ void check_log_unit(const StimulusLog& log, const Stimulus& stimulus, const std:
                                "expected readings in {} (or, for a plugin that reads several units, [stimulus] set "
                                "to the log's: temperature_hysteresis's log_unit)",
                                log.source(), log.value_name(), in_log, plugin, read, read));
+}
+
+// Whether summary.json says its run finished: not cancelled, stopped by
+// nothing. A file that cannot be read, or is not gtrack's, says not.
+bool earlier_run_finished(const fs::path& summary) {
+  try {
+    const std::string text = read_text_file(summary, 1 << 20, "a run's summary.json");
+    return text.find("\n  \"cancelled\": false,\n") != std::string::npos &&
+           text.find("\n  \"stopped_by\": null\n") != std::string::npos;
+  } catch (const Error&) {
+    return false;
+  }
 }
 
 // A pose table (--restart-from, --score-truth) for the gripper of this setup.
@@ -641,6 +654,16 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       throw ConfigError(setup.root.table("tracker").where("default_stimulus") + ": " + e.what());
     }
   }
+  const auto stimulus_plugin_name = [&] {
+    return setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "";
+  };
+  if (options.stimulus_csv && setup.stimulus && !options.follow_stimulus) {
+    // The readings' unit first: a log in another unit would otherwise be
+    // refused for its first reading past the plugin's range, pointing at
+    // the range instead of the unit.
+    check_log_unit(StimulusLog::load(*options.stimulus_csv, {}, options.stimulus_column), *setup.stimulus,
+                   stimulus_plugin_name());
+  }
   if (options.stimulus_csv) {
     StimulusLog::ReadingCheck check;
     if (can_probe) {
@@ -659,10 +682,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                      " frames, none of them in --frames " + std::to_string(range.first) + ":" +
                      (range.last >= 0 ? std::to_string(range.last) : std::string()));
   }
-  if (log && setup.stimulus) {
-    const std::string plugin = setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "";
-    check_log_unit(*log, *setup.stimulus, plugin);
-  }
+  if (log && setup.stimulus && options.follow_stimulus) check_log_unit(*log, *setup.stimulus, stimulus_plugin_name());
   if (log && !options.follow_stimulus) check_log_covers_frames(*log, options, range, expected, fps, config.tracker.fps,
                                                                   source->fps());
 
@@ -989,7 +1009,11 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   warn_unused(options.restart_from, restart_rows, restarts_used, "--restart-from", "the frame before a tracked one");
   warn_unused(options.score_truth, reference_rows, references_used, "--score-truth", "a tracked frame");
   // Resuming a finished run tracks nothing: its summary stays as it was.
-  if (!(resumed && summary.frames == 0)) write_summary(options.out_dir / "summary.json", summary);
+  // One that had been stopped after its last frame (a two-pass run
+  // interrupted in its backward pass) is replaced: it would still say
+  // cancelled.
+  const fs::path summary_file = options.out_dir / "summary.json";
+  if (!(resumed && summary.frames == 0 && earlier_run_finished(summary_file))) write_summary(summary_file, summary);
   return summary;
 }
 
