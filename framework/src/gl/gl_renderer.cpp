@@ -2,6 +2,7 @@
 // draw + dispatch; counts back through one fence.
 #include "gl/gl_renderer.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -19,6 +20,38 @@ namespace gtrack {
 namespace gl {
 
 namespace {
+
+// A point near what the projection images, from which the vertex shader's
+// float coordinates are taken, so that they are sizes of the gripper rather
+// than its distance from the world's origin (a probe placed metres from it,
+// where a float's step is half a micrometre): a camera's centre, or for an
+// affine projection (a slice) the point imaged at the image's centre that
+// lies midway between its clip planes.
+Eigen::Vector3d render_origin(const Projection& p) {
+  const Eigen::Matrix<double, 3, 4>& m = p.world_to_image;
+  const Eigen::Matrix3d a = m.leftCols<3>();
+  if (m.row(2).head<3>().norm() > 0) {
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(a);
+    if (lu.isInvertible()) {
+      const Eigen::Vector3d c = lu.solve(-m.col(3));
+      if (c.allFinite()) return c;
+    }
+    return Eigen::Vector3d::Zero();
+  }
+  Eigen::MatrixXd rows(2 + static_cast<Eigen::Index>(p.clip_planes.size()), 3);
+  Eigen::VectorXd rhs(rows.rows());
+  rows.row(0) = m.row(0).head<3>();
+  rhs[0] = p.size.width / 2.0 - m(0, 3);
+  rows.row(1) = m.row(1).head<3>();
+  rhs[1] = p.size.height / 2.0 - m(1, 3);
+  for (size_t i = 0; i < p.clip_planes.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(2 + i);
+    rows.row(k) = p.clip_planes[i].head<3>().transpose();
+    rhs[k] = -p.clip_planes[i][3];
+  }
+  const Eigen::Vector3d o = rows.completeOrthogonalDecomposition().solve(rhs);
+  return o.allFinite() ? o : Eigen::Vector3d::Zero();
+}
 
 constexpr int kLayerBits = 32;         // hypotheses per R32UI layer
 constexpr int kCountGroupWidth = 32;   // columns per count workgroup
@@ -268,7 +301,12 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
   clip.row(0) = (2.0 / w) * m.row(0) - m.row(2);
   clip.row(1) = m.row(2) - (2.0 / h) * m.row(1);
   clip.row(3) = m.row(2);
-  const Eigen::Matrix4f clip_f = clip.cast<float>();
+  // A world point x is x' + origin: clip = clip T(origin) x', and a plane
+  // (n, d) is (n, d + n.origin).
+  const Eigen::Vector3d origin = render_origin(p);
+  Eigen::Matrix4d moved = Eigen::Matrix4d::Identity();
+  moved.block<3, 1>(0, 3) = origin;
+  const Eigen::Matrix4f clip_f = (clip * moved).cast<float>();
   gl_.ProgramUniformMatrix4fv(draw_program_, u_clip_, 1, GL_FALSE, clip_f.data());
 
   float planes[kMaxClipPlanes * 4];
@@ -276,6 +314,7 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
     // Unused planes keep everything (0 x + 1 >= 0) and stay disabled.
     Eigen::Vector4d pl(0, 0, 0, 1);
     if (i < static_cast<int>(p.clip_planes.size())) pl = p.clip_planes[static_cast<size_t>(i)];
+    pl[3] += pl.head<3>().dot(origin);
     for (int k = 0; k < 4; ++k) planes[4 * i + k] = float(pl[k]);
     if (i < max_clip_planes_) {
       if (i < static_cast<int>(p.clip_planes.size())) {
@@ -289,6 +328,7 @@ void GlRenderer::set_projection(const Projection& projection, double scale) {
 
   const bool resized = p.size.width != projection_.size.width || p.size.height != projection_.size.height;
   projection_ = p;
+  origin_ = origin;
   has_projection_ = true;
   gl_.Viewport(0, 0, w, h);
   if (resized || observation_ == 0) {
@@ -422,6 +462,9 @@ void GlRenderer::reserve_layers(int layers) {
 void GlRenderer::upload_hypotheses(const double* data, int count) {
   staging_.resize(static_cast<size_t>(count) * static_cast<size_t>(dims_));
   std::transform(data, data + staging_.size(), staging_.begin(), [](double v) { return float(v); });
+  for (size_t at = 0; at < staging_.size(); at += static_cast<size_t>(dims_)) {
+    for (int k = 0; k < 3; ++k) staging_[at + k] = float(data[at + k] - origin_[k]);
+  }
   gl_.NamedBufferSubData(hypothesis_buffer_, 0, GLsizeiptr(staging_.size() * sizeof(float)), staging_.data());
 }
 

@@ -93,6 +93,9 @@ class GlRenderer final : public Renderer {
   int vertices_ = 0;
   double reach_mm_ = 0;
   Projection projection_;  // at render size
+  // Where the vertex shader's coordinates start (render_origin): the
+  // hypotheses' positions are uploaded less it, computed in double.
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   bool has_projection_ = false;
   std::uint64_t observation_count_ = 0;
 
