@@ -242,7 +242,7 @@ TEST(PinholeMicroscope, BadCalibrationFilesAreOneLineNamingFileAndKey) {
                "distortion_model 'equidistant'");
   expect_error(write("tilt.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"
                                  "distortion_coefficients: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.01, 0]\n"),
-               "has 13 coefficients with thin-prism or tilt terms");
+               "has 14 coefficients with thin-prism or tilt terms");
   // A distortion under a name that is not read would leave the lens
   // uncorrected without a word.
   expect_error(write("dist_coeff.yml", "%YAML:1.0\n---\ncamera_matrix: [6400, 0, 320, 0, 6400, 240, 0, 0, 1]\n"

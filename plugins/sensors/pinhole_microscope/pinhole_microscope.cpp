@@ -199,9 +199,10 @@ Calibration read_calibration(const gtrack::ConfigTable& t, const char* key) {
     }
     // Thin-prism and tilt terms (coefficients 9-14) that are zero are no
     // terms at all; 1-8 coefficients are completed with zeros.
+    const size_t given = d.size();
     while (d.size() > 8 && d.back() == 0) d.pop_back();
     if (d.size() > 8) {
-      t.fail(key, name + ": '" + dist.first + "' has " + std::to_string(d.size()) +
+      t.fail(key, name + ": '" + dist.first + "' has " + std::to_string(given) +
                       " coefficients with thin-prism or tilt terms; this sensor models k1, k2, p1, p2, k3, k4, k5, k6");
     }
     if (!d.empty()) d.resize(d.size() <= 4 ? 4 : d.size() == 5 ? 5 : 8, 0.0);
