@@ -31,7 +31,7 @@ class CountsRenderer final : public gtrack::Renderer {
   void finish(std::vector<gtrack::PairCounts>& out) override {
     ++finished;
     if (fail_finish) throw gtrack::Error("counts: lost the device");
-    out.assign(counts.begin(), counts.begin() + n_);
+    out.assign(counts.begin(), counts.begin() + std::min<std::ptrdiff_t>(n_, std::ssize(counts)));
   }
   cv::Mat render_mask(const Eigen::VectorXd&) override { return {}; }
 
@@ -115,6 +115,21 @@ TEST(Cost, ARenderersErrorLeavesNoOtherViewsBatchPending) {
     EXPECT_EQ(t.size(), 2u);
     for (const CountsRenderer* r : {&a, &b, &c}) EXPECT_EQ(r->finished, r->submitted);
   }
+  // A view that returns too few counts is named with its own count, not
+  // that of a view collected after it.
+  CountsRenderer a, b;
+  a.counts = {{10, 10}};
+  b.counts = {{10, 10}, {10, 10}};
+  gtrack::CostEvaluator two({&a, &b}, g, nullptr, gtrack::CostWeights{});
+  try {
+    two.evaluate(Eigen::MatrixXd::Zero(8, 1), t);  // one hypothesis: both agree
+    a.counts.clear();
+    two.evaluate(h, t);
+    ADD_FAILURE() << "a view's missing counts were taken";
+  } catch (const gtrack::Error& e) {
+    EXPECT_STREQ(e.what(), "renderer 'counts' returned 0 counts for 2 hypotheses");
+  }
+  EXPECT_EQ(b.finished, b.submitted);
 }
 
 // A gripper plugin's K that is no number is its error, named, not a cost

@@ -432,10 +432,11 @@ TEST(Fault, AnInputThatFailsAtOnceLeavesTheEarlierRun) {
   EXPECT_EQ(read_text(o.out_dir / "summary.json"), summary);
 }
 
-// A resume that finds every frame done keeps a finished run's summary, and
-// replaces one that says the run was stopped (a two-pass run interrupted
-// in its backward pass has its forward frames all done): it had gone on
-// saying cancelled after the resume completed the run.
+// A resume that finds every frame done keeps a finished run's summary; one
+// that says the run was cancelled (a two-pass run interrupted in its
+// backward pass has its forward frames all done) keeps its figures and
+// says it is not (it had gone on saying cancelled after the resume
+// completed the run); one that names an error keeps it.
 TEST(Fault, AResumeWithNothingLeftKeepsAFinishedSummaryAndMendsAStoppedOne) {
   const fs::path dir = fresh_dir("resume_nothing_left");
   const TrackRun r = make_run();
@@ -453,9 +454,14 @@ TEST(Fault, AResumeWithNothingLeftKeepsAFinishedSummaryAndMendsAStoppedOne) {
   stopped.replace(stopped.find(no), no.size(), yes);
   std::ofstream(file, std::ios::trunc) << stopped;
   EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, again).frames, 0);
-  const std::string mended = read_text(file);
-  EXPECT_NE(mended.find(no), std::string::npos) << mended;
-  EXPECT_NE(mended.find("\"resumed_after_frame\": " + std::to_string(kFrames - 1) + ","), std::string::npos) << mended;
+  EXPECT_EQ(read_text(file), finished);
+  std::string failed = stopped;
+  const std::string none = "\"stopped_by\": null";
+  ASSERT_NE(failed.find(none), std::string::npos) << failed;
+  failed.replace(failed.find(none), none.size(), "\"stopped_by\": \"overlay.mp4: cannot be closed\"");
+  std::ofstream(file, std::ios::trunc) << failed;
+  EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, again).frames, 0);
+  EXPECT_EQ(read_text(file), failed);
 }
 
 // A file the run cannot write is named as the run's file, not its

@@ -16,7 +16,9 @@
 // (its frame index or time_s, as the header says), and throws for one it
 // refuses (a stimulus plugin's update() given a temperature in kelvin, or
 // a change too fast for its rate limit); the error is then
-// "file:line: <its message>".
+// "file:line: <its message>". A HeaderCheck sees the log once its header
+// is read, before any row (value_name() is known then), and throws for a
+// log it refuses as a whole (a readings' column in another unit).
 #pragma once
 
 #include <chrono>
@@ -36,11 +38,12 @@ class GTRACK_API StimulusLog {
   enum class Key { Frame, Time };
 
   using ReadingCheck = std::function<void(double value, Key key, double at)>;
+  using HeaderCheck = std::function<void(const StimulusLog& log)>;
 
   static StimulusLog load(const std::filesystem::path& file, ReadingCheck check = {},
-                          const std::string& column = "");
+                          const std::string& column = "", HeaderCheck header_check = {});
   static StimulusLog parse(const std::string& text, const std::string& source = "<string>",
-                           ReadingCheck check = {}, const std::string& column = "");
+                           ReadingCheck check = {}, const std::string& column = "", HeaderCheck header_check = {});
   // A log still being written (a live run): poll() takes the rows appended
   // since the last call, whole lines only, with the same checks as parse()
   // (errors name the file and line); true when rows were added. The file may
@@ -50,7 +53,7 @@ class GTRACK_API StimulusLog {
   // header, a first reading the check refuses, a file that shrinks or is
   // replaced by one without the rows read so far throw.
   static StimulusLog follow(const std::filesystem::path& file, ReadingCheck check = {},
-                            const std::string& column = "");
+                            const std::string& column = "", HeaderCheck header_check = {});
   bool poll();
   // The last row's reading; nullopt while there is none.
   std::optional<double> latest() const;
@@ -98,6 +101,7 @@ class GTRACK_API StimulusLog {
   double shift_s_ = 0;                   // shift_time(): seconds taken from the keys
   std::string source_;
   ReadingCheck check_;
+  HeaderCheck header_check_;
   bool header_ = false;
   int lines_ = 0;                        // lines read so far (for error messages)
   std::filesystem::path followed_;       // follow(): the file

@@ -138,10 +138,11 @@ void CostEvaluator::evaluate(const Eigen::MatrixXd& hypotheses, std::vector<Cost
       throw;
     }
     if (static_cast<int>(counts_.size()) != n) {
+      const std::string said = "renderer '" + r->name() + "' returned " + std::to_string(counts_.size()) +
+                               " counts for " + std::to_string(n) + " hypotheses";
       ++pending_from;
-      collect_pending();
-      throw Error("renderer '" + r->name() + "' returned " + std::to_string(counts_.size()) + " counts for " +
-                  std::to_string(n) + " hypotheses");
+      collect_pending();  // (which overwrites counts_)
+      throw Error(said);
     }
     const std::uint64_t observed = r->observation_count();
     for (int i = 0; i < n; ++i) {

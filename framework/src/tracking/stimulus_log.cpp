@@ -52,7 +52,8 @@ constexpr size_t kMaxLine = 4096;
 
 }  // namespace
 
-StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck check, const std::string& column) {
+StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck check, const std::string& column,
+                              HeaderCheck header_check) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
     throw InputError(file.string() + ": is a folder; expected a stimulus log (a CSV file)");
@@ -64,14 +65,15 @@ StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck ch
     text += line;
     text += '\n';
   }
-  return parse(text, file.string(), std::move(check), column);
+  return parse(text, file.string(), std::move(check), column, std::move(header_check));
 }
 
 StimulusLog StimulusLog::parse(const std::string& text, const std::string& source, ReadingCheck check,
-                               const std::string& column) {
+                               const std::string& column, HeaderCheck header_check) {
   StimulusLog log;
   log.source_ = source;
   log.check_ = std::move(check);
+  log.header_check_ = std::move(header_check);
   log.column_ = column;
   std::istringstream in(text);
   std::string line;
@@ -149,6 +151,7 @@ void StimulusLog::take_line(std::string line) {
     value_field_ = static_cast<size_t>(at - fields.begin());
     field_count_ = fields.size();
     value_name_ = *at;
+    if (header_check_) header_check_(*this);  // refused as a whole: as a bad header
     header_ = true;
     return;
   }
@@ -191,10 +194,12 @@ void StimulusLog::take_line(std::string line) {
   values_.push_back(v);
 }
 
-StimulusLog StimulusLog::follow(const std::filesystem::path& file, ReadingCheck check, const std::string& column) {
+StimulusLog StimulusLog::follow(const std::filesystem::path& file, ReadingCheck check, const std::string& column,
+                                HeaderCheck header_check) {
   StimulusLog log;
   log.source_ = file.string();
   log.check_ = std::move(check);
+  log.header_check_ = std::move(header_check);
   log.column_ = column;
   log.followed_ = file;
   std::ifstream probe(file, std::ios::binary);

@@ -271,16 +271,23 @@ void check_log_unit(const StimulusLog& log, const Stimulus& stimulus, const std:
                                log.source(), log.value_name(), in_log, plugin, read, read));
 }
 
-// Whether summary.json says its run finished: not cancelled, stopped by
-// nothing. A file that cannot be read, or is not gtrack's, says not.
-bool earlier_run_finished(const fs::path& summary) {
+// A resume that finds every frame done: summary.json keeps the figures of
+// the run that tracked them. One that says that run was cancelled with no
+// error (a two-pass run interrupted in its backward pass, its forward
+// frames all done) now says it is not, since the run is complete; one that
+// names an error keeps it. A file that cannot be read is left alone.
+void mend_cancelled_summary(const fs::path& summary) {
+  std::string text;
   try {
-    const std::string text = read_text_file(summary, 1 << 20, "a run's summary.json");
-    return text.find("\n  \"cancelled\": false,\n") != std::string::npos &&
-           text.find("\n  \"stopped_by\": null\n") != std::string::npos;
+    text = read_text_file(summary, 1 << 20, "a run's summary.json");
   } catch (const Error&) {
-    return false;
+    return;
   }
+  const std::string cancelled = "\n  \"cancelled\": true,\n";
+  const auto at = text.find(cancelled);
+  if (at == std::string::npos || text.find("\n  \"stopped_by\": null\n") == std::string::npos) return;
+  text.replace(at, cancelled.size(), "\n  \"cancelled\": false,\n");
+  detail::replace_file(summary, text);
 }
 
 // A pose table (--restart-from, --score-truth) for the gripper of this setup.
@@ -654,25 +661,26 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
       throw ConfigError(setup.root.table("tracker").where("default_stimulus") + ": " + e.what());
     }
   }
-  const auto stimulus_plugin_name = [&] {
-    return setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "";
-  };
-  if (options.stimulus_csv && setup.stimulus && !options.follow_stimulus) {
-    // The readings' unit first: a log in another unit would otherwise be
-    // refused for its first reading past the plugin's range, pointing at
-    // the range instead of the unit.
-    check_log_unit(StimulusLog::load(*options.stimulus_csv, {}, options.stimulus_column), *setup.stimulus,
-                   stimulus_plugin_name());
-  }
   if (options.stimulus_csv) {
+    // The readings' unit once the header is read, before any row: a log in
+    // another unit would otherwise be refused for its first reading past
+    // the plugin's range, pointing at the range instead of the unit.
+    StimulusLog::HeaderCheck unit;
+    if (setup.stimulus) {
+      unit = [&setup](const StimulusLog& header) {
+        check_log_unit(header, *setup.stimulus,
+                       setup.root.has("stimulus") ? setup.root.table("stimulus").string_or("plugin", "") : "");
+      };
+    }
     StimulusLog::ReadingCheck check;
     if (can_probe) {
       check = [probe = make_probe(), fps](double value, StimulusLog::Key key, double at) {
         probe->update(value, key == StimulusLog::Key::Time ? at : at / fps);
       };
     }
-    log = options.follow_stimulus ? StimulusLog::follow(*options.stimulus_csv, std::move(check), options.stimulus_column)
-                                  : StimulusLog::load(*options.stimulus_csv, std::move(check), options.stimulus_column);
+    log = options.follow_stimulus
+              ? StimulusLog::follow(*options.stimulus_csv, std::move(check), options.stimulus_column, std::move(unit))
+              : StimulusLog::load(*options.stimulus_csv, std::move(check), options.stimulus_column, std::move(unit));
     if (options.stimulus_offset_s != 0) log->shift_time(options.stimulus_offset_s);
   }
   const int expected = expected_frames(*source, range);
@@ -682,7 +690,6 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                      " frames, none of them in --frames " + std::to_string(range.first) + ":" +
                      (range.last >= 0 ? std::to_string(range.last) : std::string()));
   }
-  if (log && setup.stimulus && options.follow_stimulus) check_log_unit(*log, *setup.stimulus, stimulus_plugin_name());
   if (log && !options.follow_stimulus) check_log_covers_frames(*log, options, range, expected, fps, config.tracker.fps,
                                                                   source->fps());
 
@@ -1008,12 +1015,13 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // A frame restarts from the row of the frame before it.
   warn_unused(options.restart_from, restart_rows, restarts_used, "--restart-from", "the frame before a tracked one");
   warn_unused(options.score_truth, reference_rows, references_used, "--score-truth", "a tracked frame");
-  // Resuming a finished run tracks nothing: its summary stays as it was.
-  // One that had been stopped after its last frame (a two-pass run
-  // interrupted in its backward pass) is replaced: it would still say
-  // cancelled.
+  // Resuming a finished run tracks nothing: its summary stays, said done.
   const fs::path summary_file = options.out_dir / "summary.json";
-  if (!(resumed && summary.frames == 0 && earlier_run_finished(summary_file))) write_summary(summary_file, summary);
+  if (resumed && summary.frames == 0) {
+    mend_cancelled_summary(summary_file);
+  } else {
+    write_summary(summary_file, summary);
+  }
   return summary;
 }
 
