@@ -139,6 +139,20 @@ TEST(Dicom, NativeFramesAreTheImagesWrittenAtTheFilesRate) {
     EXPECT_NEAR(pixel->second, 0.095, 1e-12) << syntax;
   }
 
+  // Without a region, Pixel Spacing (row spacing, then column spacing, mm);
+  // a region, when there is one, is what an ultrasound image is measured by.
+  DicomWriteOptions spacing;
+  spacing.pixel_spacing = "0.12\\0.1";
+  write_dicom(dir / "spacing.dcm", written, spacing);
+  const auto spaced = gtrack::open_frame_source((dir / "spacing.dcm").string(), {40, 30}, {}, 30)->pixel_size_mm();
+  ASSERT_TRUE(spaced);
+  EXPECT_DOUBLE_EQ(spaced->first, 0.1);
+  EXPECT_DOUBLE_EQ(spaced->second, 0.12);
+  spacing.region_cm_x = spacing.region_cm_y = 0.009;
+  write_dicom(dir / "spacing.dcm", written, spacing);
+  EXPECT_DOUBLE_EQ(gtrack::open_frame_source((dir / "spacing.dcm").string(), {40, 30}, {}, 30)->pixel_size_mm()->first,
+                   0.09);
+
   // Scanners export without an extension: "DICM" at byte 128 says what it is.
   fs::copy_file(dir / "cine.dcm", dir / "IM_0001");
   EXPECT_EQ(read_all(dir / "IM_0001", {40, 30}).size(), 3u);
@@ -171,6 +185,20 @@ TEST(Dicom, AFolderOfSingleFrameFilesIsAFolderOfImages) {
   const auto from_export = read_all(exported, {40, 30});
   ASSERT_EQ(from_export.size(), 3u);
   EXPECT_TRUE(same(from_export[2], bgr(written[2])));
+  EXPECT_FALSE(gtrack::open_frame_source(exported.string(), {40, 30}, {}, 30)->pixel_size_mm());
+  // Its pixel size is its first file's, as a multi-frame file's is (a
+  // folder's had gone unchecked against the sensor's).
+  DicomWriteOptions region;
+  region.region_cm_x = region.region_cm_y = 0.012;
+  write_dicom(exported / "IM_0001", {written[0]}, region);
+  const auto pixel = gtrack::open_frame_source(exported.string(), {40, 30}, {}, 30)->pixel_size_mm();
+  ASSERT_TRUE(pixel);
+  EXPECT_DOUBLE_EQ(pixel->first, 0.12);
+  // The index itself as --input: said to be one, not tried as a video.
+  EXPECT_NE(input_error(exported / "DICOMDIR").find("DICOMDIR: a DICOMDIR, the index of a scanner's export, holds no "
+                                                     "frames; give the folder of the images it lists"),
+            std::string::npos)
+      << input_error(exported / "DICOMDIR");
   write_dicom(dir / "IM3.dcm", written);
   const std::string e = input_error(dir);
   EXPECT_NE(e.find("IM3.dcm: a DICOM file of 3 frames in a folder of images; give the file itself as --input"),

@@ -35,6 +35,7 @@ struct DicomWriteOptions {
   bool strip_jfif = false;       // ".jpg": the JFIF marker taken out, as some scanners write theirs
   bool sequence_before = false;  // an undefined-length sequence before the image tags
   double region_cm_x = 0, region_cm_y = 0;  // > 0: an ultrasound region with this pixel size (cm)
+  std::string pixel_spacing;     // (0028,0030) "row\\column" in mm, "": none
 };
 
 class DicomWriter {
@@ -197,6 +198,7 @@ inline void write_dicom(const std::filesystem::path& file, const std::vector<cv:
     d.raw(item.bytes());
   }
   if (o.frame_time_ms > 0) d.element(0x0018, 0x1063, "DS", std::to_string(o.frame_time_ms));
+  if (!o.pixel_spacing.empty()) d.element(0x0028, 0x0030, "DS", o.pixel_spacing);
   if (!o.frame_time_vector.empty()) d.element(0x0018, 0x1065, "DS", o.frame_time_vector);
   d.us(0x0028, 0x0002, colour ? 3 : 1);
   d.element(0x0028, 0x0004, "CS", o.photometric.empty() ? (colour ? "RGB" : "MONOCHROME2") : o.photometric);

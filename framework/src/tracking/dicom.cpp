@@ -502,6 +502,9 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
   r.transfer_syntax = ts;
 
   double frame_time_ms = 0, cine_rate = 0, display_rate = 0;
+  // Pixel Spacing, else Imager Pixel Spacing: row spacing (y), then column
+  // spacing (x), in mm; taken when no ultrasound region gives the size.
+  std::vector<double> pixel_spacing, imager_spacing;
   std::vector<double> frame_time_vector;
   std::vector<std::uint64_t> extended_offsets;
   std::optional<Header> pixels;
@@ -536,6 +539,8 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
       case tag(0x0018, 0x1063): frame_time_ms = r.decimal(h).value_or(0); break;
       case tag(0x0018, 0x1065): frame_time_vector = r.decimals(h, 1u << 24); break;
       case tag(0x0018, 0x0040): cine_rate = r.decimal(h).value_or(0); break;
+      case tag(0x0028, 0x0030): pixel_spacing = r.decimals(h); break;
+      case tag(0x0018, 0x1164): imager_spacing = r.decimals(h); break;
       case tag(0x0008, 0x2144): display_rate = r.decimal(h).value_or(0); break;
       case tag(0x7FE0, 0x0001): {
         // Extended offset table: 8-byte offsets, one per frame.
@@ -581,6 +586,16 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
         break;
       }
       default: r.skip_value(h, explicit_vr, 1);
+    }
+  }
+  if (!(out.region_mm_x > 0)) {
+    for (const auto& spacing : {pixel_spacing, imager_spacing}) {
+      if (spacing.size() == 2 && spacing[0] > 0 && spacing[1] > 0 && std::isfinite(spacing[0]) &&
+          std::isfinite(spacing[1])) {
+        out.region_mm_x = spacing[1];
+        out.region_mm_y = spacing[0];
+        break;
+      }
     }
   }
   if (!pixels) throw InputError(name + ": holds no pixel data (7FE0,0010); expected an image");

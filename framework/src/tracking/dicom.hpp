@@ -37,8 +37,10 @@ struct DicomLayout {
   bool rle = false;             // RLE lossless: decoded by decode_rle_frame()
   bool video = false;           // MPEG-2, H.264 or HEVC: the fragments hold one video stream, not a frame each
   double fps = 0;               // from the frame time (vector) or the cine rate; 0 when the file gives none
-  // The first 2D ultrasound region's pixel size (0018,6011: PhysicalDeltaX
-  // and Y in cm), in mm; 0 when the file gives none.
+  // The pixel size the file gives, in mm (x: across, y: down): the first 2D
+  // ultrasound region's (0018,6011: PhysicalDeltaX and Y in cm), else Pixel
+  // Spacing (0028,0030), else Imager Pixel Spacing (0018,1164); 0 when the
+  // file gives none.
   double region_mm_x = 0, region_mm_y = 0;
   // Why the file holds fewer whole frames than it says (cut short), or "".
   std::string cut_short;

@@ -590,6 +590,19 @@ class FolderSource final : public FrameSource {
     return dir_.string() + (following() ? " (followed: new images are taken as they arrive)"
                                         : " (" + std::to_string(files_.size()) + " images)");
   }
+  // A folder of single-frame DICOM files (a scanner's export): the pixel
+  // size its first file gives, as a multi-frame file's.
+  std::optional<std::pair<double, double>> pixel_size_mm() const override {
+    if (files_.empty() || !is_dicom_name(files_.front())) return std::nullopt;
+    try {
+      std::ifstream in(files_.front(), std::ios::binary);
+      const detail::DicomLayout layout = detail::read_dicom_layout(in, files_.front().string());
+      if (layout.region_mm_x > 0 && layout.region_mm_y > 0) return std::make_pair(layout.region_mm_x, layout.region_mm_y);
+    } catch (const Error&) {
+      // Its frame says what is wrong with it when it is read.
+    }
+    return std::nullopt;
+  }
 
  private:
   bool following() const { return follow_.idle_s > 0; }
@@ -1481,6 +1494,10 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& spec, ImageSiz
   if (fs::is_directory(p, ec)) return std::make_unique<FolderSource>(p, expected, range, fallback_fps, follow);
   if (detail::is_tiff_file(spec)) return std::make_unique<StackSource>(spec, expected, range, fallback_fps);
   if (detail::is_dicom_file(spec)) return std::make_unique<DicomSource>(spec, expected, range, fallback_fps);
+  if (p.filename() == "DICOMDIR" && fs::is_regular_file(p, ec)) {
+    throw InputError(spec + ": a DICOMDIR, the index of a scanner's export, holds no frames; give the folder of the "
+                            "images it lists, or a multi-frame DICOM file among them, as --input");
+  }
   return open_video(spec, expected, range, fallback_fps, false);  // a missing path: "no such file or folder"
 }
 
