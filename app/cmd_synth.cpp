@@ -65,7 +65,8 @@ int run_synth(const gtrack::cli::CommonOptions& common, const po::variables_map&
             << o.preset << ", seed " << o.seed << ") in " << s.seconds << " s -> " << out.string() << "\n"
             << "  occluded frames: " << s.occluded_frames << " (" << 100.0 * s.occluded_frames / s.frames
             << "%), mean " << 100 * s.mean_occlusion << "% of the shape, max " << 100 * s.max_occlusion << "%\n"
-            << "  partly out of view (10-99% inside): " << s.partly_out_frames << ", out of view (<10% inside): "
+            << "  partly out of view (10-99% imaged: inside the image, and a slice's slab): " << s.partly_out_frames
+            << ", out of view (<10% imaged): "
             << s.out_of_view_frames << "\n"
             << std::defaultfloat << std::setprecision(6)  // readings in any unit: significant digits
             << "  stimulus: " << s.stimulus_min << " to " << s.stimulus_max << unit

@@ -108,6 +108,34 @@ TEST(Synth, ATurnedProbeSeesTheSequenceAnUprightOneSees) {
   }
 }
 
+// A slice images only its slab: the truth's in_view is the share of the
+// whole gripper imaged, so a gripper tilted out of the plane is partly out
+// of view and one beside the slab out of view (both had been 1: the share
+// was taken of the part inside the slab).
+TEST(Synth, APartOutsideASlicesSlabIsOutOfView) {
+  const gtrack::Setup setup = gtrack::testing::probe_setup();
+  gtrack::SynthOptions o;
+  o.frames = 1;
+  o.preset = "ultrasound";
+  o.occlusion_scale = 0;
+  auto plan = gtrack::plan_sequence(setup, o);
+  Eigen::VectorXd& h = plan.frames[0].truth;
+  h.head<3>() = setup.sensor->nominal_position_mm();
+  h.segment<3>(3).setZero();
+  gtrack::SynthVisibility flat, tilted, beside;
+  gtrack::render_frame(setup, plan, 0, &flat);
+  h[3] = 60;
+  gtrack::render_frame(setup, plan, 0, &tilted);
+  h[3] = 0;
+  h.head<3>() += 5 * gtrack::viewing_axis(setup.sensor->projection());
+  gtrack::render_frame(setup, plan, 0, &beside);
+  EXPECT_GT(flat.in_view, 0.99);
+  EXPECT_LT(tilted.in_view, 0.5);
+  EXPECT_GT(tilted.in_view, 0.02);
+  EXPECT_EQ(beside.in_view, 0);
+  EXPECT_DOUBLE_EQ(tilted.visible, tilted.in_view);
+}
+
 // A config's camera rate ([tracker] fps) is the sequence's frame rate.
 TEST(Synth, TheConfigsFrameRateIsTheSequences) {
   const std::string text = "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\nfx = 3200.0\n"
@@ -443,7 +471,10 @@ TEST(Synth, SynthTableErrorsNameTheKeyAndLeaveTheFolderAlone) {
   // Readings the stimulus plugin refuses (a profile in kelvin), by their key,
   // however few frames would reach them.
   const std::string kelvin = message("stimulus_low = 295.0\nstimulus_high = 305.0\n");
-  EXPECT_NE(kelvin.find("key 'synth.stimulus_low': a reading of 295"), std::string::npos) << kelvin;
+  EXPECT_NE(kelvin.find("key 'synth.stimulus_low': the stimulus plugin refused the reading 295, the profile's low "
+                        "end, as a first reading at t = 0: a reading of 295"),
+            std::string::npos)
+      << kelvin;
   const std::string noise = message("stimulus_noise = 1e9\n");
   EXPECT_NE(noise.find("key 'synth.stimulus_noise': a reading of"), std::string::npos) << noise;
   EXPECT_FALSE(fs::exists(dir));

@@ -130,6 +130,25 @@ cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int index, Synth
     grid.resolve(alpha, &shade);
     full_area = cv::sum(alpha)[0];
   }
+  // The shares are of the gripper's whole shape: a slice's slab (its clip
+  // planes) images only part of it, and what lies outside the slab is not
+  // seen, as what lies outside the image is not.
+  double whole_area = full_area;
+  if (!canvas.clip_planes.empty()) {
+    Projection unclipped = canvas;
+    unclipped.clip_planes.clear();
+    const auto whole = gripper_polygons(model, fr, unclipped);
+    std::vector<Eigen::Vector2d> corners;
+    for (const auto& s : whole) corners.insert(corners.end(), s.poly.v, s.poly.v + s.poly.count);
+    const cv::Rect box = synth::bounding_rect(corners.data(), static_cast<int>(corners.size())) & canvas_rect;
+    if (box.area() > 0) {
+      SampleGrid grid(box, kSupersample);
+      for (const auto& s : whole) grid.fill_convex(s.poly.v, s.poly.count, 255);
+      cv::Mat whole_alpha;
+      grid.resolve(whole_alpha);
+      whole_area = std::max(full_area, cv::sum(whole_alpha)[0]);
+    }
+  }
   const cv::Rect in_roi = inter - roi.tl();
   const cv::Rect in_image = inter - image_in_canvas.tl();
   if (inter.area() > 0) {
@@ -142,7 +161,7 @@ cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int index, Synth
     cv::Mat mixed = a3.mul(col) + (cv::Scalar::all(1.0) - a3).mul(dst);
     mixed.copyTo(dst);
   }
-  if (full_area > 0) vis.in_view = in_view_area / full_area;
+  if (whole_area > 0) vis.in_view = in_view_area / whole_area;
 
   // Occluder, sized to hide the planned share of what is in view.
   const OccluderPlan& occ = fr.occluder;
@@ -187,7 +206,7 @@ cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int index, Synth
     }
   }
   if (in_view_area > 0) vis.occluded = covered / in_view_area;
-  if (full_area > 0) vis.visible = (in_view_area - covered) / full_area;
+  if (whole_area > 0) vis.visible = (in_view_area - covered) / whole_area;
   if (visibility) *visibility = vis;
 
   // Through the lens: the tracker undistorts the frame back (Sensor::rectify).

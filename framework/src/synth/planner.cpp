@@ -202,6 +202,25 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   const Eigen::Vector2d half_view(0.5 * size.width * pixel.x(), 0.5 * size.height * pixel.y());
   const Eigen::Vector2d room = (half_view.array() - radius).max(0.25 * radius).matrix();
 
+  // A slice's slab (two opposite clip planes, -d1 <= n.x <= d2): a depth
+  // motion past half its thickness takes the palm out of the imaging
+  // plane, and the frames show little of the gripper.
+  const auto planes = sensor.projection().clip_planes;
+  for (size_t a = 0; a < planes.size(); ++a) {
+    for (size_t b = a + 1; b < planes.size(); ++b) {
+      const double norm = planes[a].head<3>().norm();
+      if (!(norm > 0) || (planes[a].head<3>() + planes[b].head<3>()).norm() > 1e-9 * norm) continue;
+      const double half = 0.5 * (planes[a][3] + planes[b][3]) / norm;
+      if (p.depth_amplitude_mm > half) {
+        logger().warn("{}: [synth] depth_amplitude_mm {:g} moves the gripper up to {:g} mm out of the imaging plane, "
+                      "past the slab's half thickness of {:g} mm: frames will image little of it (set [synth] "
+                      "depth_amplitude_mm to at most {:g})",
+                      setup.root.source().empty() ? std::string("the config") : setup.root.source(),
+                      p.depth_amplitude_mm, p.depth_amplitude_mm, half, half);
+      }
+    }
+  }
+
   const double base_hz = 1.0 / p.motion_period_s;
   const auto px = SmoothPath(rng, base_hz).sample(times), py = SmoothPath(rng, base_hz).sample(times);
   const auto pz = SmoothPath(rng, base_hz).sample(times);
@@ -238,7 +257,9 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
     try {
       setup.loader->make_stimulus(setup.root.table("stimulus"))->update(value, 0);
     } catch (const std::exception& e) {
-      synth_table.fail(key, e.what());
+      synth_table.fail(key, fmt::format("the stimulus plugin refused the reading {:g}, the profile's {} end, as a first "
+                                        "reading at t = 0: {}",
+                                        value, key == std::string("stimulus_low") ? "low" : "high", e.what()));
     }
   }
   const int F = model.fingers(), L = model.max_links();
