@@ -3,12 +3,20 @@
 #include <iostream>
 
 #include "command.hpp"
+#include "gtrack/config.hpp"
 #include "gtrack/plugin_loader.hpp"
+#include "gtrack/setup.hpp"
 
 namespace {
 
 int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_options::variables_map& vm) {
   gtrack::PluginLoader loader(common.plugin_paths);
+  // A config's plugin_path too, searched after --plugin-path, as track
+  // searches it: what that config would find.
+  if (vm.count("config")) {
+    const auto root = gtrack::ConfigTable::load_file(vm["config"].as<std::string>());
+    for (const auto& dir : gtrack::config_plugin_paths(root)) loader.add_path(dir);
+  }
   if (vm.count("paths")) {  // the folders alone: no plugin is opened
     for (const auto& p : loader.search_paths()) std::cout << p.string() << "\n";
     return 0;
@@ -44,6 +52,8 @@ int run_plugins(const gtrack::cli::CommonOptions& common, const boost::program_o
 
 GTRACK_COMMAND("plugins", "list the plugins found: kind, name, version, file, what it is",
                [](boost::program_options::options_description& d) {
-                 d.add_options()("paths", "print the folders searched, in order, instead");
+                 d.add_options()("config,c", boost::program_options::value<std::string>(),
+                                 "also search the folders this config's plugin_path names, as track does")(
+                     "paths", "print the folders searched, in order, instead");
                },
                run_plugins)

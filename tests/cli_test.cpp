@@ -104,6 +104,24 @@ TEST(Cli, PluginsListsTheBuiltInsEachFromItsOwnLibrary) {
       << r.output;  // what it is, last
 }
 
+// With --config, what a run of that config finds: its plugin_path too,
+// relative to its folder, searched after --plugin-path.
+TEST(Cli, PluginsWithAConfigSearchItsPluginPath) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "plugins_config";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "lab_plugins");
+  std::ofstream(dir / "lab.toml") << "plugin_path = [\"lab_plugins\"]\n";
+  const CliRun paths = gtrack("plugins --paths --config " + (dir / "lab.toml").string());
+  ASSERT_EQ(paths.code, 0) << paths.output;
+  EXPECT_EQ(paths.output.rfind((dir / "lab_plugins").string() + "\n", 0), 0u) << paths.output;
+  const CliRun listed = gtrack("plugins -c " + (dir / "lab.toml").string());
+  EXPECT_EQ(listed.code, 0) << listed.output;
+  EXPECT_NE(listed.output.find("gripper\thydrogel_six_finger\t"), std::string::npos) << listed.output;
+  const CliRun missing = gtrack("plugins -c " + (dir / "none.toml").string());
+  EXPECT_EQ(missing.code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("none.toml"), std::string::npos) << missing.output;
+}
+
 // The common options that take a value may come before the command, spelt
 // either way; the folder given is searched first.
 TEST(Cli, CommonOptionsMayComeBeforeTheCommand) {

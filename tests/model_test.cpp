@@ -182,4 +182,20 @@ TEST(Model, ALinkThatIsNoNumberIsRefusedNamingIt) {
             "gripper 'lab': finger 1, link 2: widths nan and 0.1 mm; expected finite numbers, neither negative nor "
             "both 0");
   EXPECT_NE(error(geometry(0.5, -0.1)).find("link 2: widths -0.1 and 0.1 mm"), std::string::npos);
+  // A compiled gripper is held to what a model file is: a finger floating
+  // off the palm, a reference fold past the joints' limits and an adjacent
+  // pair of no finger are refused, naming what is wrong.
+  gtrack::GripperGeometry floating = geometry(0.5, 0.2);
+  floating.fingers[0].base_mm = {1.8, 0};
+  EXPECT_EQ(error(floating), "gripper 'lab': finger 1's base [1.8, 0] is 0.8 mm off the palm's outline; expected its "
+                             "first hinge on it");
+  gtrack::GripperGeometry bent = geometry(0.5, 0.2);
+  bent.joint_max_deg = 90;
+  bent.folded_deg = 200;
+  EXPECT_EQ(error(bent), "gripper 'lab': folded_deg is 200, outside the joint limits [0, 90]; expected a fold the "
+                         "joints can take");
+  gtrack::GripperGeometry paired = geometry(0.5, 0.2);
+  paired.collision.adjacent = {{0, 5}};
+  EXPECT_EQ(error(paired), "gripper 'lab': the adjacent pair (0, 5) names a finger that does not exist; expected "
+                           "finger indices 0 to 1 (CollisionRule::adjacent counts from 0)");
 }

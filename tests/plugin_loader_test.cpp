@@ -222,6 +222,14 @@ TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {
            {"throws = \"projection\"", "the sensor plugin's projection() threw: projection not calibrated"},
            {"throws = \"project\"", "the sensor plugin's project() threw: no lens model yet"},
            {"clip_planes = 9", "the sensor plugin's projection() has 9 clip planes; expected at most 8"},
+           // A pixel size or a project() that is not the projection's: synth
+           // had drawn blank frames, and the search box was sized wrong.
+           {"mm_per_pixel = 50.0",
+            "the sensor plugin's mm_per_pixel() is 50 mm, but projection() images 1 to 1 mm a pixel about "
+            "nominal_position_mm(); expected the projection's pixel size"},
+           {"project_turned = true",
+            "the sensor plugin's project() and projection() disagree: the point (6.4, 0, 0) mm images at (-0.0, "
+            "6.4) by project() and (6.4, 0.0) by projection(); expected the same pixel but for lens distortion"},
            {"nan = \"projection_row\"",
             "the sensor plugin's projection() images the world about nominal_position_mm() onto a line or a point "
             "(at 1 and 0 pixels per mm in its two directions); expected a world_to_image of rank 3"}}) {

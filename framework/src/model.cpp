@@ -261,9 +261,34 @@ ArticulatedModel::ArticulatedModel(GripperGeometry g) : geometry_(std::move(g)) 
     }
   }
   for (auto [a, b] : G.collision.adjacent) {
-    if (a < 0 || b < 0 || a >= fingers() || b >= fingers())
-      throw Error("gripper '" + G.name + "': adjacency names a finger that does not exist");
+    if (a < 0 || b < 0 || a >= fingers() || b >= fingers()) {
+      throw Error(fmt::format("gripper '{}': the adjacent pair ({}, {}) names a finger that does not exist; expected "
+                              "finger indices 0 to {} (CollisionRule::adjacent counts from 0)",
+                              G.name, a, b, fingers() - 1));
+    }
     if (a == b) throw Error("gripper '" + G.name + "': a finger cannot be adjacent to itself");
+  }
+  // What a compiled gripper is held to as a model file is (data_defined):
+  // each finger's first hinge on the palm's outline (a finger elsewhere
+  // is drawn floating beside the palm, or out of its middle), and the
+  // reference folds within the joint limits.
+  double palm_radius = 0;
+  for (const auto& p : G.palm_mm) palm_radius = std::max(palm_radius, p.norm());
+  for (size_t f = 0; f < G.fingers.size(); ++f) {
+    const Eigen::Vector2d& base = G.fingers[f].base_mm;
+    const double off = distance_to_outline(base, G.palm_mm);
+    if (!(off <= 0.05 * palm_radius)) {
+      throw Error(fmt::format("gripper '{}': finger {}'s base [{:g}, {:g}] is {:.3g} mm off the palm's outline; "
+                              "expected its first hinge on it",
+                              G.name, f + 1, base.x(), base.y(), off));
+    }
+  }
+  for (const auto& [name, q] : {std::pair<const char*, double>{"unfolded_deg", G.unfolded_deg}, {"folded_deg", G.folded_deg}}) {
+    if (!(q >= G.joint_min_deg && q <= G.joint_max_deg)) {
+      throw Error(fmt::format("gripper '{}': {} is {:g}, outside the joint limits [{:g}, {:g}]; expected a fold the "
+                              "joints can take",
+                              G.name, name, q, G.joint_min_deg, G.joint_max_deg));
+    }
   }
   int links = 0;
   double extent = 0;

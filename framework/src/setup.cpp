@@ -116,6 +116,37 @@ void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
                        sv[0], sv[1]),
            "a world_to_image of rank 3 (each image direction its own row)");
   }
+  // mm_per_pixel() sizes the search box and synth's motion and occluders:
+  // it must be the projection's pixel, between its finest and coarsest
+  // direction about the nominal position (a slice's pixels need not be
+  // square), within 25 %.
+  if (!(mm >= 0.8 / sv[0] && mm <= 1.25 / sv[1])) {
+    refuse(fmt::format("mm_per_pixel() is {:.4g} mm, but projection() images {:.4g} to {:.4g} mm a pixel about "
+                       "nominal_position_mm()",
+                       mm, 1 / sv[0], 1 / sv[1]),
+           "the projection's pixel size");
+  }
+  // project() is projection() and the lens distortion rectify() removes:
+  // a point a tenth of the image from the nominal position lands on the same
+  // pixel, give or take a fifth of its distance (a project() left unturned
+  // or unmirrored when projection() was, and synth draws blank frames).
+  {
+    const double step = 0.1 * std::min(projection.size.width, projection.size.height) * mm;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d x = nominal + step * Eigen::Vector3d::Unit(k);
+      const auto linear = image_of(x);
+      const auto full = call("project()", [&] { return sensor.project(x); });
+      if (!linear || !full) continue;  // off a slice's slab, behind the camera
+      const double apart = (*full - *linear).norm();
+      if (!(apart <= 0.2 * (*linear - *centre).norm() + 2)) {
+        refuse(fmt::format("project() and projection() disagree: the point ({:.4g}, {:.4g}, {:.4g}) mm images at "
+                           "({:.1f}, {:.1f}) by project() and ({:.1f}, {:.1f}) by projection()",
+                           x.x(), x.y(), x.z(), full->x(), full->y(), linear->x(), linear->y()),
+               "the same pixel but for lens distortion (project() is projection() with the distortion that rectify() "
+               "removes)");
+      }
+    }
+  }
   const ImageSize image = call("image_size()", [&] { return sensor.image_size(); });
   const ImageSize drawn = projection.size;
   if (image.width <= 0 || image.height <= 0 || drawn.width != image.width || drawn.height != image.height) {
@@ -128,17 +159,23 @@ void check_projection_size(const ConfigTable& table, const Sensor& sensor) {
 
 }  // namespace
 
+std::vector<fs::path> config_plugin_paths(const ConfigTable& root) {
+  const fs::path base = root.base_folder().empty() ? fs::path(".") : root.base_folder();
+  std::vector<fs::path> out;
+  for (const auto& p : root.strings_or("plugin_path", {})) {
+    fs::path dir(p);
+    out.push_back(dir.is_absolute() ? dir : base / dir);
+  }
+  return out;
+}
+
 Setup load_setup(const ConfigTable& root, const SetupOptions& options) {
   Setup s;
   s.root = root;
   s.config_file = root.source();
   s.plugin_paths = options.plugin_paths;
   auto loader = std::make_shared<PluginLoader>(options.plugin_paths);
-  const fs::path base = root.base_folder().empty() ? fs::path(".") : root.base_folder();
-  for (const auto& p : root.strings_or("plugin_path", {})) {
-    fs::path dir(p);
-    loader->add_path(dir.is_absolute() ? dir : base / dir);
-  }
+  for (const auto& dir : config_plugin_paths(root)) loader->add_path(dir);
   s.loader = loader;
   for (const char* t : {"sensor", "gripper"}) {
     if (!root.has(t)) {

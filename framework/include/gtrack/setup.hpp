@@ -39,6 +39,10 @@ struct SetupOptions {
   bool with_stimulus = true;
 };
 
+// The folders a config's plugin_path names, relative ones taken from the
+// config's folder: searched after SetupOptions::plugin_paths.
+GTRACK_API std::vector<std::filesystem::path> config_plugin_paths(const ConfigTable& root);
+
 GTRACK_API Setup load_setup(const ConfigTable& root, const SetupOptions& options);
 GTRACK_API Setup load_setup(const std::filesystem::path& config_file, const SetupOptions& options);
 
