@@ -94,16 +94,21 @@ Observation Segmenter::observe(const cv::Mat& frame, const ObservationPrior* pri
   obs.detected = static_cast<std::uint64_t>(cv::countNonZero(obs.mask));
 
   if (have_prior && config_.prior && obs.detected > 0) {
-    // Distance of every pixel to the previous model: distanceTransform
-    // measures to the nearest zero, so the model's pixels are the zeros.
+    // Distance of every observed pixel to the previous model:
+    // distanceTransform measures to the nearest zero, so the model's pixels
+    // are the zeros. Taken within the box of both (the exact transform's
+    // distances do not depend on pixels past the nearest zero), not over
+    // the whole render image.
+    const cv::Rect box = cv::boundingRect(prior->previous_mask) | cv::boundingRect(obs.mask);
     cv::Mat outside, dist;
-    cv::compare(prior->previous_mask, 0, outside, cv::CMP_EQ);
+    cv::compare(prior->previous_mask(box), 0, outside, cv::CMP_EQ);
     cv::distanceTransform(outside, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     const double sigma_render = config_.prior_sigma_px * widen * 0.5 * (sx + sy);
     // p = exp(-d^2 / 2 sigma^2) >= threshold  <=>  d <= sigma sqrt(-2 ln threshold).
     const double max_d = sigma_render * std::sqrt(-2.0 * std::log(config_.prior_threshold));
-    cv::Mat near;
-    cv::compare(dist, max_d, near, cv::CMP_LE);
+    cv::Mat near = cv::Mat::zeros(obs.mask.size(), CV_8U);
+    cv::Mat near_box = near(box);
+    cv::compare(dist, max_d, near_box, cv::CMP_LE);
     cv::bitwise_and(obs.mask, near, obs.mask);
   }
   obs.count = static_cast<std::uint64_t>(cv::countNonZero(obs.mask));
