@@ -91,6 +91,19 @@ TEST(PluginLoader, NotFoundListsPathsAndAvailablePlugins) {
   EXPECT_NE(e.find("/nonexistent/dir"), std::string::npos) << e;
   EXPECT_NE(e.find("available sensor plugins: pinhole_microscope"), std::string::npos) << e;
   EXPECT_EQ(e.find("hydrogel"), std::string::npos) << "lists only plugins of the kind asked for: " << e;
+  // A library of the name without gtrack's prefix (add_library instead of
+  // gtrack_add_plugin) is pointed out.
+  const fs::path dir = fs::temp_directory_path() / "gtrack_plugin_loader_test" / "unprefixed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(kFixtures / "libgtrack_fixture_good_sensor.so", dir / "liblab_camera.so");
+  gtrack::PluginLoader lab({dir});
+  e = plugin_error([&] { lab.make_sensor(table("lab_camera")); });
+  EXPECT_NE(e.find((dir / "liblab_camera.so").string() + " is there, but a plugin's file is named "
+                   "libgtrack_lab_camera.so (gtrack_add_plugin names it so)"),
+            std::string::npos)
+      << e;
+  fs::remove_all(dir);
 }
 
 TEST(PluginLoader, RefusesAnAbiMismatchBeforeCallingAnything) {

@@ -281,6 +281,18 @@ fs::path PluginLoader::find(PluginKind kind, const std::string& name) const {
                     library_file_name(name) + " in: " + join_paths(paths_) + ")";
   msg += known.empty() ? std::string("; no ") + to_string(kind) + " plugins were found there"
                        : std::string("; available ") + to_string(kind) + " plugins: " + known;
+  // A library of that name without the prefix (built with add_library
+  // instead of gtrack_add_plugin): said, as the likely cause.
+  for (const auto& dir : paths_) {
+    for (const std::string& other : {"lib" + name + ".so", name + ".so"}) {
+      std::error_code ec;
+      if (fs::is_regular_file(dir / other, ec)) {
+        msg += "; " + (dir / other).string() + " is there, but a plugin's file is named " + library_file_name(name) +
+               " (gtrack_add_plugin names it so)";
+        throw PluginError(msg);
+      }
+    }
+  }
   throw PluginError(msg);
 }
 
