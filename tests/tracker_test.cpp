@@ -48,15 +48,20 @@ std::string engine_config_error(const std::string& extra) {
   return "";
 }
 
-// A camera frame of the gripper at h: red-ish gripper on a grey, noisy background.
-cv::Mat scene(const gtrack::Setup& setup, const Eigen::VectorXd& h, std::uint64_t seed) {
+// The gripper at h as the cpu backend renders it, at the image's size.
+cv::Mat rendered_mask(const gtrack::Setup& setup, const Eigen::VectorXd& h) {
   gtrack::RenderOptions ro;
   ro.backend = "cpu";
   ro.scale = 1.0;
   auto r = gtrack::make_cpu_renderer(ro);
   r->set_model(setup.model());
   r->set_projection(setup.sensor->projection(), 1.0);
-  const cv::Mat mask = r->render_mask(h);
+  return r->render_mask(h);
+}
+
+// A camera frame of the gripper at h: red-ish gripper on a grey, noisy background.
+cv::Mat scene(const gtrack::Setup& setup, const Eigen::VectorXd& h, std::uint64_t seed) {
+  const cv::Mat mask = rendered_mask(setup, h);
   cv::Mat img(mask.size(), CV_8UC3, cv::Scalar(120, 125, 130));
   cv::Mat noise(mask.size(), CV_8UC3);
   cv::RNG rng(seed);
@@ -1096,13 +1101,7 @@ TEST(Tracker, TiltMarginIsWideForAFoldedGripperAndNarrowForAFlatOne) {
 TEST(Tracker, TheOverlayIsDrawnWhereTheModelIsRendered) {
   auto setup = make_setup();
   const Eigen::VectorXd h = pose(0.3, -0.2, 20, 30);
-  gtrack::RenderOptions ro;
-  ro.backend = "cpu";
-  ro.scale = 1.0;
-  auto r = gtrack::make_cpu_renderer(ro);
-  r->set_model(setup.model());
-  r->set_projection(setup.sensor->projection(), 1.0);
-  const cv::Mat mask = r->render_mask(h);
+  const cv::Mat mask = rendered_mask(setup, h);
   gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
   gtrack::Estimate e;
   e.hypothesis = h;
