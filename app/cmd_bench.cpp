@@ -100,6 +100,7 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   gl.renderer = try_make(gtrack::make_gl_renderer, 0, gl.why);
   cpu_all.frames = gl.frames = true;
   std::vector<double> ratio1, ratio_n;
+  std::vector<double> gl_hyp_ratio, gl_fps_ratio;  // gl over cpu (all threads), round by round
   for (int round = 0; round < rounds; ++round) {
     for (Backend* b : {&cpu1, &cpu_all, &base1, &base_all, &gl}) {
       if (!b->renderer) continue;
@@ -118,6 +119,10 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
     }
     ratio1.push_back(cpu1.hyp.back() / base1.hyp.back());
     ratio_n.push_back(cpu_all.hyp.back() / base_all.hyp.back());
+    if (gl.renderer && !gl.hyp.empty()) {
+      gl_hyp_ratio.push_back(gl.hyp.back() / cpu_all.hyp.back());
+      gl_fps_ratio.push_back(gl.fps.back() / cpu_all.fps.back());
+    }
   }
   const auto median = [](std::vector<double> v) -> std::optional<double> {
     if (v.empty()) return std::nullopt;
@@ -128,13 +133,16 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   const auto range = [](const std::vector<double>& v) {
     const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
     char text[48];
-    std::snprintf(text, sizeof text, "%.1f-%.1f", *lo, *hi);
+    std::snprintf(text, sizeof text, "%.3g-%.3g", *lo, *hi);
     return std::string(text);
   };
   const Measured m_cpu1{median(cpu1.hyp)}, m_cpu_all{median(cpu_all.hyp)}, m_cpu_frames{median(cpu_all.fps)},
       m_base1{median(base1.hyp)}, m_base_all{median(base_all.hyp)}, m_gl{median(gl.hyp), gl.why},
       m_gl_frames{median(gl.fps), gl.why};
   const double ratio_one = *median(ratio1), ratio_all = *median(ratio_n);
+  // The gl backend's ratios only from rounds it finished (it may fail part way).
+  const std::optional<double> gl_over_cpu = m_gl.value ? median(gl_hyp_ratio) : std::nullopt;
+  const std::optional<double> gl_over_cpu_frames = m_gl.value ? median(gl_fps_ratio) : std::nullopt;
   if (json) {
     std::cout << "{\"hypotheses_per_s\": {\"cpu\": " << json_number(m_cpu_all.value)
               << ", \"gl\": " << json_number(m_gl.value) << ", \"opencv_baseline\": " << json_number(m_base_all.value)
@@ -153,6 +161,8 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
               << ", \"seconds_per_measurement\": " << seconds << ", \"rounds\": " << rounds
               << ", \"cpu_over_opencv_baseline_range\": {\"1\": \"" << range(ratio1) << "\", \"" << all << "\": \""
               << range(ratio_n) << "\"}";
+    std::cout << ",\n \"gl_over_cpu\": {\"hypotheses_per_s\": " << json_number(gl_over_cpu)
+              << ", \"frames_per_s\": " << json_number(gl_over_cpu_frames) << "}";
     if (!m_gl.value) std::cout << ",\n \"gl_unavailable\": " << gtrack::json_string(m_gl.note);
     std::cout << "}\n";
     return 0;
@@ -169,6 +179,11 @@ int run_bench(const gtrack::cli::CommonOptions& common, const po::variables_map&
   std::printf("\ncpu / opencv_baseline: %.1fx (1 thread), %.1fx (%d threads): the medians of %d rounds' ratios "
               "(ranges %s and %s)\n",
               ratio_one, ratio_all, all, rounds, range(ratio1).c_str(), range(ratio_n).c_str());
+  if (gl_over_cpu && gl_over_cpu_frames) {
+    std::printf("gl / cpu (%d threads): %.3gx hypotheses/s, %.3gx PSO frames/s: the medians of the rounds' ratios "
+                "(ranges %s and %s)\n",
+                all, *gl_over_cpu, *gl_over_cpu_frames, range(gl_hyp_ratio).c_str(), range(gl_fps_ratio).c_str());
+  }
   std::printf("PSO frame = N=32 particles x G=25 generations with the cost of eq. (1); no segmentation or I/O\n");
   if (!m_gl.value) std::printf("gl: not measured: %s\n", m_gl.note.c_str());
   return 0;

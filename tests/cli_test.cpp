@@ -1182,6 +1182,11 @@ TEST(Cli, UsageErrors) {
   }
   EXPECT_EQ(r.output.find("\"cpu\": null"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("\"opencv_baseline\": null"), std::string::npos) << r.output;
+  // gl against cpu, as a ratio of the same run, whenever gl was measured.
+  EXPECT_NE(r.output.find("\"gl_over_cpu\": {\"hypotheses_per_s\": "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\"gl\": null") == std::string::npos,
+            r.output.find("\"gl_over_cpu\": {\"hypotheses_per_s\": null") == std::string::npos)
+      << r.output;
   r = gtrack("bench --rounds 0");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--rounds must be in 1-100"), std::string::npos) << r.output;
