@@ -170,11 +170,7 @@ inline std::uint64_t seed_option(const boost::program_options::variables_map& vm
 // each other across the viewing axis) has its "in-plane" error within the
 // imaging plane and its "depth" error across it, not below the probe.
 inline bool images_a_slab(const gtrack::Sensor& sensor) {
-  const gtrack::Projection p = sensor.projection();
-  if (p.clip_planes.size() != 2) return false;
-  const Eigen::Vector3d axis = gtrack::viewing_axis(p);
-  const Eigen::Vector3d a = p.clip_planes[0].head<3>().normalized(), b = p.clip_planes[1].head<3>().normalized();
-  return std::abs(std::abs(a.dot(axis)) - 1) < 1e-6 && a.dot(b) < -1 + 1e-6;
+  return gtrack::slab_thickness_mm(sensor.projection()).has_value();
 }
 
 // The synthetic preset to draw a config's frames with (gtrack synth, gtrack

@@ -1,4 +1,5 @@
 // A sensor's own frame, and the sensor seen from it (see sensor.hpp).
+#include <cmath>
 #include <utility>
 
 #include "gtrack/model.hpp"
@@ -58,6 +59,19 @@ Eigen::Vector3d viewing_axis(const Projection& projection) {
   Eigen::Vector3d axis = m.row(2).transpose();
   if (axis.norm() == 0) axis = m.row(0).transpose().cross(m.row(1).transpose());
   return axis.norm() > 0 ? Eigen::Vector3d(axis.normalized()) : Eigen::Vector3d::UnitZ();
+}
+
+std::optional<double> slab_thickness_mm(const Projection& projection) {
+  if (projection.clip_planes.size() != 2) return std::nullopt;
+  const Eigen::Vector4d& a = projection.clip_planes[0];
+  const Eigen::Vector4d& b = projection.clip_planes[1];
+  const double na = a.head<3>().norm(), nb = b.head<3>().norm();
+  if (!(na > 0 && nb > 0)) return std::nullopt;
+  const Eigen::Vector3d axis = viewing_axis(projection);
+  const Eigen::Vector3d ua = a.head<3>() / na, ub = b.head<3>() / nb;
+  if (!(std::abs(std::abs(ua.dot(axis)) - 1) < 1e-6 && ua.dot(ub) < -1 + 1e-6)) return std::nullopt;
+  // Kept: -a3/|a| <= ua.x and ua.x <= b3/|b|.
+  return a[3] / na + b[3] / nb;
 }
 
 bool SensorFrame::is_world() const { return (axes - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12; }

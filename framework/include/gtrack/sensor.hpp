@@ -69,6 +69,11 @@ GTRACK_API Eigen::Vector2d pixel_size_mm(const Sensor& sensor);
 // normal of an orthographic view or an ultrasound slice.
 GTRACK_API Eigen::Vector3d viewing_axis(const Projection& projection);
 
+// The thickness (mm) of the slab a projection images, for an ultrasound
+// slice: its two clip planes facing each other across the viewing axis;
+// none for any other projection.
+GTRACK_API std::optional<double> slab_thickness_mm(const Projection& projection);
+
 // A sensor's own frame: axes whose columns are the image's u direction, the
 // direction normal to it within the image, and the viewing axis (unit,
 // right-handed), turning about `origin`, the nominal position. A point p

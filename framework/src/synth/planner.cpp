@@ -202,23 +202,15 @@ SynthPlan plan_sequence(const Setup& setup, const SynthOptions& options) {
   const Eigen::Vector2d half_view(0.5 * size.width * pixel.x(), 0.5 * size.height * pixel.y());
   const Eigen::Vector2d room = (half_view.array() - radius).max(0.25 * radius).matrix();
 
-  // A slice's slab (two opposite clip planes, -d1 <= n.x <= d2): a depth
-  // motion past half its thickness takes the palm out of the imaging
-  // plane, and the frames show little of the gripper.
-  const auto planes = sensor.projection().clip_planes;
-  for (size_t a = 0; a < planes.size(); ++a) {
-    for (size_t b = a + 1; b < planes.size(); ++b) {
-      const double norm = planes[a].head<3>().norm();
-      if (!(norm > 0) || (planes[a].head<3>() + planes[b].head<3>()).norm() > 1e-9 * norm) continue;
-      const double half = 0.5 * (planes[a][3] + planes[b][3]) / norm;
-      if (p.depth_amplitude_mm > half) {
-        logger().warn("{}: [synth] depth_amplitude_mm {:g} moves the gripper up to {:g} mm out of the imaging plane, "
-                      "past the slab's half thickness of {:g} mm: frames will image little of it (set [synth] "
-                      "depth_amplitude_mm to at most {:g})",
-                      setup.root.source().empty() ? std::string("the config") : setup.root.source(),
-                      p.depth_amplitude_mm, p.depth_amplitude_mm, half, half);
-      }
-    }
+  // A slice's slab: a depth motion past half its thickness takes the palm
+  // out of the imaging plane, and the frames show little of the gripper.
+  if (const auto slab = slab_thickness_mm(sensor.projection()); slab && p.depth_amplitude_mm > 0.5 * *slab) {
+    const double half = 0.5 * *slab;
+    logger().warn("{}: [synth] depth_amplitude_mm {:g} moves the gripper up to {:g} mm out of the imaging plane, past "
+                  "the slab's half thickness of {:g} mm: frames will image little of it (set [synth] "
+                  "depth_amplitude_mm to at most {:g})",
+                  setup.root.source().empty() ? std::string("the config") : setup.root.source(), p.depth_amplitude_mm,
+                  p.depth_amplitude_mm, half, half);
   }
 
   const double base_hz = 1.0 / p.motion_period_s;
