@@ -138,15 +138,23 @@ cv::Mat render_frame(const Setup& setup, const SynthPlan& plan, int index, Synth
     Projection unclipped = canvas;
     unclipped.clip_planes.clear();
     const auto whole = gripper_polygons(model, fr, unclipped);
-    std::vector<Eigen::Vector2d> corners;
-    for (const auto& s : whole) corners.insert(corners.end(), s.poly.v, s.poly.v + s.poly.count);
-    const cv::Rect box = synth::bounding_rect(corners.data(), static_cast<int>(corners.size())) & canvas_rect;
-    if (box.area() > 0) {
-      SampleGrid grid(box, kSupersample);
-      for (const auto& s : whole) grid.fill_convex(s.poly.v, s.poly.count, 255);
-      cv::Mat whole_alpha;
-      grid.resolve(whole_alpha);
-      whole_area = std::max(full_area, cv::sum(whole_alpha)[0]);
+    // Nothing cut (a camera's near plane, which never reaches the gripper;
+    // a slice that holds all of it): the whole shape is the one drawn, and
+    // is not drawn again.
+    const auto same = [](const ShadedPolygon& a, const ShadedPolygon& b) {
+      return a.poly.count == b.poly.count && std::equal(a.poly.v, a.poly.v + a.poly.count, b.poly.v);
+    };
+    if (!std::equal(whole.begin(), whole.end(), shaded.begin(), shaded.end(), same)) {
+      std::vector<Eigen::Vector2d> corners;
+      for (const auto& s : whole) corners.insert(corners.end(), s.poly.v, s.poly.v + s.poly.count);
+      const cv::Rect box = synth::bounding_rect(corners.data(), static_cast<int>(corners.size())) & canvas_rect;
+      if (box.area() > 0) {
+        SampleGrid grid(box, kSupersample);
+        for (const auto& s : whole) grid.fill_convex(s.poly.v, s.poly.count, 255);
+        cv::Mat whole_alpha;
+        grid.resolve(whole_alpha);
+        whole_area = std::max(full_area, cv::sum(whole_alpha)[0]);
+      }
     }
   }
   const cv::Rect in_roi = inter - roi.tl();
