@@ -578,8 +578,7 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
           // Format 1: 2D (tissue); absent: taken as 2D. Units 3: cm.
           const bool spatial = (g.format == 1 || g.format == -1) && g.units_x == 3 && (g.units_y == 3 || g.units_y == 0);
           if (spatial && g.dx > 0 && g.dy > 0 && std::isfinite(g.dx) && std::isfinite(g.dy)) {
-            out.region_mm_x = 10 * g.dx;
-            out.region_mm_y = 10 * g.dy;
+            out.pixel_mm = std::make_pair(10 * g.dx, 10 * g.dy);
             break;
           }
         }
@@ -588,12 +587,11 @@ DicomLayout read_dicom_layout(std::istream& in, const std::string& name) {
       default: r.skip_value(h, explicit_vr, 1);
     }
   }
-  if (!(out.region_mm_x > 0)) {
+  if (!out.pixel_mm) {
     for (const auto& spacing : {pixel_spacing, imager_spacing}) {
       if (spacing.size() == 2 && spacing[0] > 0 && spacing[1] > 0 && std::isfinite(spacing[0]) &&
           std::isfinite(spacing[1])) {
-        out.region_mm_x = spacing[1];
-        out.region_mm_y = spacing[0];
+        out.pixel_mm = std::make_pair(spacing[1], spacing[0]);
         break;
       }
     }

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <istream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -37,11 +38,11 @@ struct DicomLayout {
   bool rle = false;             // RLE lossless: decoded by decode_rle_frame()
   bool video = false;           // MPEG-2, H.264 or HEVC: the fragments hold one video stream, not a frame each
   double fps = 0;               // from the frame time (vector) or the cine rate; 0 when the file gives none
-  // The pixel size the file gives, in mm (x: across, y: down): the first 2D
+  // The pixel size the file gives, in mm (width, height): the first 2D
   // ultrasound region's (0018,6011: PhysicalDeltaX and Y in cm), else Pixel
-  // Spacing (0028,0030), else Imager Pixel Spacing (0018,1164); 0 when the
-  // file gives none.
-  double region_mm_x = 0, region_mm_y = 0;
+  // Spacing (0028,0030), else Imager Pixel Spacing (0018,1164); none when
+  // the file gives none.
+  std::optional<std::pair<double, double>> pixel_mm;
   // Why the file holds fewer whole frames than it says (cut short), or "".
   std::string cut_short;
 

@@ -596,8 +596,7 @@ class FolderSource final : public FrameSource {
     if (files_.empty() || !is_dicom_name(files_.front())) return std::nullopt;
     try {
       std::ifstream in(files_.front(), std::ios::binary);
-      const detail::DicomLayout layout = detail::read_dicom_layout(in, files_.front().string());
-      if (layout.region_mm_x > 0 && layout.region_mm_y > 0) return std::make_pair(layout.region_mm_x, layout.region_mm_y);
+      return detail::read_dicom_layout(in, files_.front().string()).pixel_mm;
     } catch (const Error&) {
       // Its frame says what is wrong with it when it is read.
     }
@@ -1257,8 +1256,7 @@ class DicomSource final : public FrameSource {
     return ended_early_;
   }
   std::optional<std::pair<double, double>> pixel_size_mm() const override {
-    if (!(layout_.region_mm_x > 0 && layout_.region_mm_y > 0)) return std::nullopt;
-    return std::make_pair(layout_.region_mm_x, layout_.region_mm_y);
+    return layout_.pixel_mm;
   }
   std::string description() const override {
     return spec_ + " (a DICOM file of " + std::to_string(layout_.frames) + " frame" +
