@@ -888,8 +888,15 @@ TEST(Tracker, ScoreRepeatsTheFramesCost) {
   const Eigen::VectorXd truth = pose(0.3, -0.2, 20, 30);
   EXPECT_THROW(tracker.score(truth), gtrack::Error);  // no frame yet
   tracker.set_estimate(truth);
-  tracker.process(scene(setup, truth, 1), 0, 0.0, 26.0);
-  tracker.process(scene(setup, truth, 2), 1, 1 / 30.0, 26.0);
+  // Each frame's terms are its estimate's (kept from the search's own
+  // batches, not rendered again).
+  for (int i = 0; i < 2; ++i) {
+    const auto f = tracker.process(scene(setup, truth, 1 + i), i, i / 30.0, 26.0);
+    const gtrack::CostTerms scored = tracker.score(f.hypothesis);
+    EXPECT_DOUBLE_EQ(scored.total, f.terms.total) << "frame " << i;
+    EXPECT_EQ(scored.rendered, f.terms.rendered) << "frame " << i;
+    EXPECT_EQ(scored.overlap, f.terms.overlap) << "frame " << i;
+  }
   const auto e = tracker.process(half_covered(tracker, setup, truth, 3), 2, 2 / 30.0, 26.0);
   ASSERT_GT(e.outside_allowance, 0.0);  // the budget is part of what is repeated
   ASSERT_GT(e.terms.temporal, 0.0);     // and the temporal term

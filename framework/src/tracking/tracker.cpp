@@ -264,14 +264,22 @@ struct Tracker::Impl {
         ++bookkeeping;
         return cost->evaluate_one(h);
       };
+      // A search's result, scored: its terms as the search's own batch
+      // computed them, when the result is the lowest hypothesis it evaluated
+      // (no second render and read-back of the same hypothesis).
+      const auto score_result = [&](const PsoResult& r) {
+        if (lowest && lowest->hypothesis.size() == r.best.size() && lowest->hypothesis == r.best) return lowest->terms;
+        return score(r.best);
+      };
       Eigen::VectorXd best;
       CostTerms terms;
       // `initial_pose` starts the first frame that shows anything: until a
       // configuration was found there is no `last`.
       if (searching && !last && config.tracker.initial_pose) {
-        best = optimise(*config.tracker.initial_pose, stimulus_on, rng);
+        const PsoResult r = optimise_with(config.pso, *config.tracker.initial_pose, stimulus_on, rng);
+        best = r.best;
         e.status = TrackStatus::Tracked;
-        terms = score(best);
+        terms = score_result(r);
       } else if (searching) {
         best = coarse(stimulus_on, rng).best;
         e.status = TrackStatus::Search;
@@ -283,9 +291,10 @@ struct Tracker::Impl {
           guess->head<2>() += *found_step;
           config.space.clamp(*guess);
         }
-        best = optimise(*last, stimulus_on, rng, guess ? &*guess : nullptr);
+        const PsoResult r = optimise_with(config.pso, *last, stimulus_on, rng, guess ? &*guess : nullptr);
+        best = r.best;
         e.status = TrackStatus::Tracked;
-        const CostTerms tracked = score(best);
+        const CostTerms tracked = score_result(r);
         terms = tracked;
         // The fit is judged without the rim: the true configuration of a
         // partly hidden gripper pays for the rim along the occluder's edge,
@@ -384,7 +393,7 @@ struct Tracker::Impl {
           // Reported as mirrored only when the tilt did change branch.
           e.mirrored = m.best[3] * best[3] + m.best[4] * best[4] < 0;
           best = m.best;
-          terms = score(best);
+          terms = score_result(m);
         }
       }
       if (config.tracker.refine_spread > 0 && !searching) {
@@ -404,7 +413,7 @@ struct Tracker::Impl {
         logger().debug("frame {}: refinement: result {:.4f}, refined {:.4f}", index, terms.total, r.best_cost);
         if (r.best_cost < terms.total) {
           best = r.best;
-          terms = score(best);
+          terms = score_result(r);
         }
       }
       // What is reported: the result, with the joints of the fingers the
@@ -596,9 +605,25 @@ struct Tracker::Impl {
     return std::make_pair(st.feasible_min_deg, st.feasible_max_deg);
   }
 
-  Eigen::VectorXd optimise(const Eigen::VectorXd& from, bool stimulus_on, std::mt19937_64& rng,
-                           const Eigen::VectorXd* prediction = nullptr) {
-    return optimise_with(config.pso, from, stimulus_on, rng, prediction).best;
+  // The lowest-total hypothesis of the last search (optimise_with,
+  // cmaes_from) and its terms, all computed by the search's batches on one
+  // state of the cost: score_result in process() takes them from here.
+  struct Lowest {
+    Eigen::VectorXd hypothesis;
+    CostTerms terms;
+  };
+  std::optional<Lowest> lowest;
+  std::vector<CostTerms> batch_terms;
+
+  // A search's objective: the batch's totals, remembering the lowest.
+  void evaluate_remembering_lowest(const Eigen::MatrixXd& x, Eigen::VectorXd& totals) {
+    cost->evaluate(x, batch_terms);
+    totals.resize(x.cols());
+    for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      const CostTerms& t = batch_terms[static_cast<size_t>(i)];
+      totals[i] = t.total;
+      if (!lowest || t.total < lowest->terms.total) lowest = Lowest{x.col(i), t};
+    }
   }
 
   // The refinement by CMA-ES (docs/tracker.md, "The refinement"): N samples
@@ -618,9 +643,10 @@ struct Tracker::Impl {
     options.population = population;
     options.generations = generations;
     options.step = step;
+    lowest.reset();
     return cmaes_minimize(
         start, spread(), config.space, options,
-        [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
+        [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { evaluate_remembering_lowest(x, c); }, rng);
   }
 
   // Re-detection's search from `from` with its tilt (rx, ry) turned by
@@ -671,7 +697,9 @@ struct Tracker::Impl {
     if (prediction && config.cost.temporal > 0 && init.cols() - mirrors > 1) init.col(1) = *prediction;
     ParticleSwarm pso(pso_config, config.space);
     pso.set_randomization_spread(s);
-    return pso.run(init, [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { cost->evaluate(x, c); }, rng);
+    lowest.reset();
+    return pso.run(
+        init, [&](const Eigen::MatrixXd& x, Eigen::VectorXd& c) { evaluate_remembering_lowest(x, c); }, rng);
   }
 };
 
