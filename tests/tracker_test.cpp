@@ -344,6 +344,25 @@ TEST(Tracker, AFrameLostByItsCostReportsTheHeldEstimate) {
   EXPECT_DOUBLE_EQ(e.terms.total, tracker.score(held).total);
 }
 
+// A first search that is refused (its best D above lost_dice: a speck, not
+// the gripper) gives the frame's guess but no track: the next frame searches
+// the whole image again instead of looking around the refused guess.
+TEST(Tracker, ARefusedFirstSearchAnchorsNoTrack) {
+  auto setup = make_setup("[tracker]\nlost_dice = 0.3\n");
+  gtrack::Tracker tracker(setup, gtrack::engine_config(setup));
+  cv::Mat speck(256, 256, CV_8UC3, cv::Scalar(120, 125, 130));
+  cv::rectangle(speck, cv::Rect(12, 12, 5, 5), cv::Scalar(60, 70, 200), cv::FILLED);
+  const auto first = tracker.process(speck, 0, 0.0, std::nullopt);
+  ASSERT_EQ(first.status, gtrack::TrackStatus::Lost);
+  EXPECT_GT(first.observed_pixels, 0u);
+  EXPECT_GT(first.terms.dice, 0.3);
+  EXPECT_FALSE(tracker.last_estimate().has_value());
+  const Eigen::VectorXd truth = pose(0.6, 0.5, 20, 5);
+  const auto e = tracker.process(scene(setup, truth, 2), 1, 1 / 30.0, std::nullopt);
+  EXPECT_EQ(e.status, gtrack::TrackStatus::Search);
+  EXPECT_LT((e.hypothesis.head<2>() - truth.head<2>()).norm(), 0.1);
+}
+
 // process() refuses what it cannot track with an InputError and, for a
 // frame of the wrong size, leaves the tracker as it was: a state saved
 // after the refusal does not claim the frame.

@@ -430,15 +430,23 @@ struct Tracker::Impl {
       if (terms.dice > config.tracker.lost_dice) {
         // The search's result is not taken: the frame reports the estimate
         // the track holds, scored on this frame.
+        // Before any track, the refused result is the frame's guess but
+        // anchors nothing: the next frame searches the whole image again
+        // (its ROI and prediction placed around the guess would look for
+        // the gripper where it was not found).
         ++lost;
         e.status = TrackStatus::Lost;
-        if (!last) last = best;
         forget_motion();
-        e.hypothesis = reported ? *reported : *last;
         e.unseen_fingers.clear();
         e.redetected = e.mirrored = false;
         e.tilt_margin.reset();
-        e.terms = cost->evaluate_one(e.hypothesis);
+        if (reported || last) {
+          e.hypothesis = reported ? *reported : *last;
+          e.terms = cost->evaluate_one(e.hypothesis);
+        } else {
+          e.hypothesis = best;
+          e.terms = terms;
+        }
       } else {
         lost = 0;
         // A velocity needs two estimates of one continuous track: not across
