@@ -429,11 +429,10 @@ struct Tracker::Impl {
       e.terms = reported_terms;
       if (terms.dice > config.tracker.lost_dice) {
         // The search's result is not taken: the frame reports the estimate
-        // the track holds, scored on this frame.
-        // Before any track, the refused result is the frame's guess but
-        // anchors nothing: the next frame searches the whole image again
-        // (its ROI and prediction placed around the guess would look for
-        // the gripper where it was not found).
+        // the track holds, scored on this frame. Before any track, the
+        // refused result is the frame's guess but anchors nothing: the next
+        // frame searches the whole image again (an ROI and a prediction
+        // placed around the guess would look where the gripper was not found).
         ++lost;
         e.status = TrackStatus::Lost;
         forget_motion();
