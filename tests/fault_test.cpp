@@ -1351,6 +1351,62 @@ TEST(Fault, ResumeRefusesAStimulusLogChangedSinceTheRunBegan) {
   EXPECT_EQ(gtrack::track_sequence(r.setup, r.config, o).frames, 3);  // frames 1 to 3
 }
 
+// A stimulus log that has only grown since the run began (a logger still
+// writing): the resumed run reads the bytes the run read, so its frames
+// take the readings of a run never interrupted, and says so. Grown and
+// changed before its end, it is refused as any changed log.
+TEST(Fault, ResumeReadsAGrownStimulusLogAsTheRunHadIt) {
+  const fs::path dir = fresh_dir("resume_grown_log");
+  const TrackRun r = make_run();
+  gtrack::TrackOptions o = folder_run(dir, 4);
+  const fs::path csv = dir / "stimulus.csv";
+  const std::string original = "frame,value\n0,22\n1,23\n";
+  std::ofstream(csv) << original;
+  o.stimulus_csv = csv;
+  gtrack::TrackOptions whole = o;
+  whole.out_dir = dir / "whole";
+  gtrack::track_sequence(r.setup, r.config, whole);
+  o.range.last = 2;  // frames 0 and 1, then stopped
+  gtrack::track_sequence(r.setup, r.config, o);
+
+  std::ofstream(csv, std::ios::app) << "2,24\n3,25\n";
+  o.range.last = -1;
+  o.resume = true;
+  gtrack::TrackSummary resumed;
+  const std::string said = gtrack::testing::logged([&] { resumed = gtrack::track_sequence(r.setup, r.config, o); });
+  EXPECT_EQ(resumed.frames, 2);
+  EXPECT_NE(said.find("stimulus.csv: has grown from 22 to 32 bytes since the run being resumed began; only its "
+                      "first 22, unchanged, are read"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(rows_without_time(o.out_dir / "estimates.csv"), rows_without_time(whole.out_dir / "estimates.csv"));
+  const auto rows = read_lines(o.out_dir / "estimates.jsonl");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NE(rows[3].find("\"stimulus\":23"), std::string::npos) << rows[3];  // held past the run's log, not 25
+
+  // Grown, and changed within the bytes the run read: refused.
+  std::ofstream(csv) << "frame,value\n0,22\n1,24\n2,24\n3,25\n";
+  fs::remove(o.out_dir / "tracker_state.txt");
+  gtrack::TrackOptions again = o;
+  again.out_dir = dir / "again";
+  again.resume = false;
+  again.range.last = 2;
+  std::ofstream(csv) << original;
+  gtrack::track_sequence(r.setup, r.config, again);
+  std::ofstream(csv) << "frame,value\n0,22\n1,24\n2,24\n";
+  again.range.last = -1;
+  again.resume = true;
+  try {
+    gtrack::track_sequence(r.setup, r.config, again);
+    ADD_FAILURE() << "resumed with a log changed within what the run read";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stimulus.csv: has changed since the run being resumed began (--stimulus: it "
+                                         "was 22 bytes"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // --durable syncs each frame's rows and the state to the disk: the same
 // rows as without, the state at the last frame, no temporary file left.
 // (What it guards against, a power loss, cannot be made here; the fsync

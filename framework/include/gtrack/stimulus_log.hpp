@@ -22,6 +22,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <ios>
@@ -40,8 +41,11 @@ class GTRACK_API StimulusLog {
   using ReadingCheck = std::function<void(double value, Key key, double at)>;
   using HeaderCheck = std::function<void(const StimulusLog& log)>;
 
+  // `first_bytes`: only that many bytes of the file are read (a log that
+  // has grown since a run being resumed read it, as that run read it).
   static StimulusLog load(const std::filesystem::path& file, ReadingCheck check = {},
-                          const std::string& column = "", HeaderCheck header_check = {});
+                          const std::string& column = "", HeaderCheck header_check = {},
+                          std::optional<std::uintmax_t> first_bytes = std::nullopt);
   static StimulusLog parse(const std::string& text, const std::string& source = "<string>",
                            ReadingCheck check = {}, const std::string& column = "", HeaderCheck header_check = {});
   // A log still being written (a live run): poll() takes the rows appended

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -81,16 +83,14 @@ std::optional<fs::path> decoded(std::string_view text) {
 }
 
 // "812 bytes, FNV-1a 64 0123456789abcdef", or "missing" / "unreadable".
-std::string fingerprint(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return "missing";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "unreadable";
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  std::uint64_t size = 0;
+// FNV-1a 64 of `in`'s bytes, at most `limit` of them; `size` is how many
+// were read. False when the stream failed.
+bool hash_bytes(std::istream& in, std::uint64_t limit, std::uint64_t& hash, std::uint64_t& size) {
+  hash = 0xcbf29ce484222325ull;
+  size = 0;
   std::vector<char> block(1 << 16);
-  while (in) {
-    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+  while (in && size < limit) {
+    in.read(block.data(), static_cast<std::streamsize>(std::min<std::uint64_t>(block.size(), limit - size)));
     const auto n = static_cast<size_t>(in.gcount());
     for (size_t i = 0; i < n; ++i) {
       hash ^= static_cast<unsigned char>(block[i]);
@@ -98,11 +98,38 @@ std::string fingerprint(const fs::path& path) {
     }
     size += n;
   }
-  if (in.bad()) return "unreadable";
+  return !in.bad();
+}
+
+std::string fingerprint(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return "missing";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "unreadable";
+  std::uint64_t hash = 0, size = 0;
+  if (!hash_bytes(in, UINT64_MAX, hash, size)) return "unreadable";
   char buf[64];
   std::snprintf(buf, sizeof buf, "%llu bytes, FNV-1a 64 %016llx", static_cast<unsigned long long>(size),
                 static_cast<unsigned long long>(hash));
   return buf;
+}
+
+// The size of `kept` (a fingerprint) when the file at `path` is longer and
+// starts with exactly the bytes it names: a file that has only grown.
+std::optional<std::uint64_t> grown_from(const fs::path& path, const std::string& kept) {
+  unsigned long long size = 0, hash = 0;
+  int end = 0;
+  if (std::sscanf(kept.c_str(), "%llu bytes, FNV-1a 64 %16llx%n", &size, &hash, &end) != 2 ||
+      static_cast<size_t>(end) != kept.size()) {
+    return std::nullopt;
+  }
+  std::error_code ec;
+  const auto now = fs::file_size(path, ec);
+  if (ec || now <= size) return std::nullopt;
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t h = 0, n = 0;
+  if (!in || !hash_bytes(in, size, h, n) || n != size || h != hash) return std::nullopt;
+  return size;
 }
 
 // The comment lines a text starts with (at most 10,000), without their line ends.
@@ -218,9 +245,12 @@ void write_run_config(const fs::path& file, const ConfigTable& root, bool durabl
   replace_file(file, header + text, durable);
 }
 
-void check_same_config(const fs::path& file, const ConfigTable& root, const std::vector<NamedFile>& used) {
+std::map<std::string, std::uint64_t> check_same_config(const fs::path& file, const ConfigTable& root,
+                                                       const std::vector<NamedFile>& used,
+                                                       const std::vector<std::string>& may_grow) {
+  std::map<std::string, std::uint64_t> grown;
   std::error_code ec;
-  if (!fs::exists(file, ec)) return;
+  if (!fs::exists(file, ec)) return grown;
   if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == 0) {
     throw InputError(shown(file.string(), 1 << 12) +
                      ": is empty (cut short, as a power loss can leave it without --durable); cannot resume "
@@ -257,11 +287,18 @@ void check_same_config(const fs::path& file, const ConfigTable& root, const std:
                        "; cannot resume with another file (give the files of the run being resumed, or another --out)");
     }
     if (const std::string print = fingerprint(it->path); print != kept.fingerprint) {
+      if (std::find(may_grow.begin(), may_grow.end(), kept.key) != may_grow.end()) {
+        if (const auto size = grown_from(it->path, kept.fingerprint)) {
+          grown[kept.key] = *size;
+          continue;
+        }
+      }
       throw InputError(path_shown + ": has changed since the run being resumed began (" + kept.key + ": it was " +
                        kept.fingerprint + ", is " + print +
                        "); cannot resume with another file (restore it, or choose another --out)");
     }
   }
+  return grown;
 }
 
 }  // namespace gtrack::detail

@@ -9,8 +9,11 @@
 // are taken from that folder, as the original's were.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -43,8 +46,11 @@ void write_run_config(const std::filesystem::path& file, const ConfigTable& root
 // Throws InputError, naming the first difference, when `root` is not the
 // config kept in `file`, or a file it names or one of `used` has changed.
 // A run without the copy (from an earlier release) is not checked, nor a
-// file the copy does not list.
-void check_same_config(const std::filesystem::path& file, const ConfigTable& root,
-                       const std::vector<NamedFile>& used = {});
+// file the copy does not list. A file whose name `may_grow` lists may have
+// grown, its first bytes those the copy names: returned, by name, with the
+// number of bytes the run read.
+std::map<std::string, std::uint64_t> check_same_config(const std::filesystem::path& file, const ConfigTable& root,
+                                                       const std::vector<NamedFile>& used = {},
+                                                       const std::vector<std::string>& may_grow = {});
 
 }  // namespace gtrack::detail

@@ -53,13 +53,23 @@ constexpr size_t kMaxLine = 4096;
 }  // namespace
 
 StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck check, const std::string& column,
-                              HeaderCheck header_check) {
+                              HeaderCheck header_check, std::optional<std::uintmax_t> first_bytes) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
     throw InputError(file.string() + ": is a folder; expected a stimulus log (a CSV file)");
   }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open the stimulus log");
+  std::ifstream whole(file, std::ios::binary);
+  if (!whole) throw InputError(file.string() + ": cannot open the stimulus log");
+  std::istringstream first;
+  if (first_bytes) {
+    std::string bytes(static_cast<size_t>(*first_bytes), '\0');
+    whole.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (static_cast<std::uintmax_t>(whole.gcount()) != *first_bytes) {
+      throw InputError(fmt::format("{}: holds fewer than the {} bytes to be read", file.string(), *first_bytes));
+    }
+    first.str(std::move(bytes));
+  }
+  std::istream& in = first_bytes ? static_cast<std::istream&>(first) : whole;
   std::string text, line;
   for (int n = 1; read_bounded_line(in, line, kMaxLine, file.string(), n, "'frame,value' or 'time_s,value' rows"); ++n) {
     text += line;

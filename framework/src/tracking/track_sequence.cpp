@@ -569,6 +569,7 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
   // library and the plugins'. run_config.toml keeps their fingerprints, and
   // a resumed run refuses to go on once one has changed.
   std::vector<NamedFile> used;
+  std::optional<std::uintmax_t> log_bytes;  // of a grown log, the bytes the run being resumed read
   if (options.stimulus_csv && !options.follow_stimulus) used.push_back({"", "--stimulus", *options.stimulus_csv});
   used.push_back({"", "gtrack library", framework_library_file()});
   if (setup.loader) {
@@ -591,7 +592,12 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
                        "--stimulus-column and --stimulus-offset, or another --out; a run that followed its stimulus "
                        "log cannot be resumed)");
     }
-    detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root, used);
+    // A stimulus log may have grown since (a logger still writing): the
+    // run read it once at its start, and the resumed one reads those bytes
+    // only, so that its frames take the readings the run would have.
+    const auto grown = detail::check_same_config(options.out_dir / detail::kRunConfigName, setup.root, used,
+                                                 {"--stimulus"});
+    if (const auto it = grown.find("--stimulus"); it != grown.end()) log_bytes = it->second;
     const int every = std::max(1, range.every);
     if (resumed->frame >= range.first) range.first += ((resumed->frame - range.first) / every + 1) * every;
   } else if (options.resume) {
@@ -680,7 +686,16 @@ TrackSummary track_sequence(const Setup& setup, const EngineConfig& config, cons
     }
     log = options.follow_stimulus
               ? StimulusLog::follow(*options.stimulus_csv, std::move(check), options.stimulus_column, std::move(unit))
-              : StimulusLog::load(*options.stimulus_csv, std::move(check), options.stimulus_column, std::move(unit));
+              : StimulusLog::load(*options.stimulus_csv, std::move(check), options.stimulus_column, std::move(unit),
+                                  log_bytes);
+    if (log_bytes) {
+      std::error_code ec;
+      const auto now = fs::file_size(*options.stimulus_csv, ec);
+      logger().info("{}: has grown from {} to {} bytes since the run being resumed began; only its first {}, "
+                    "unchanged, are read, as that run read them (a new run, without --resume, reads the rows added)",
+                    options.stimulus_csv->string(), *log_bytes, ec ? std::string("?") : std::to_string(now),
+                    *log_bytes);
+    }
     if (options.stimulus_offset_s != 0) log->shift_time(options.stimulus_offset_s);
   }
   const int expected = expected_frames(*source, range);
