@@ -1385,8 +1385,6 @@ TEST(Fault, ResumeReadsAGrownStimulusLogAsTheRunHadIt) {
   EXPECT_NE(rows[3].find("\"stimulus\":23"), std::string::npos) << rows[3];  // held past the run's log, not 25
 
   // Grown, and changed within the bytes the run read: refused.
-  std::ofstream(csv) << "frame,value\n0,22\n1,24\n2,24\n3,25\n";
-  fs::remove(o.out_dir / "tracker_state.txt");
   gtrack::TrackOptions again = o;
   again.out_dir = dir / "again";
   again.resume = false;

@@ -82,7 +82,6 @@ std::optional<fs::path> decoded(std::string_view text) {
   return fs::path(out);
 }
 
-// "812 bytes, FNV-1a 64 0123456789abcdef", or "missing" / "unreadable".
 // FNV-1a 64 of `in`'s bytes, at most `limit` of them; `size` is how many
 // were read. False when the stream failed.
 bool hash_bytes(std::istream& in, std::uint64_t limit, std::uint64_t& hash, std::uint64_t& size) {
@@ -101,6 +100,7 @@ bool hash_bytes(std::istream& in, std::uint64_t limit, std::uint64_t& hash, std:
   return !in.bad();
 }
 
+// "812 bytes, FNV-1a 64 0123456789abcdef", or "missing" / "unreadable".
 std::string fingerprint(const fs::path& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return "missing";

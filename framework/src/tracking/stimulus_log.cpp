@@ -62,6 +62,10 @@ StimulusLog StimulusLog::load(const std::filesystem::path& file, ReadingCheck ch
   if (!whole) throw InputError(file.string() + ": cannot open the stimulus log");
   std::istringstream first;
   if (first_bytes) {
+    const auto size = std::filesystem::file_size(file, ec);
+    if (ec || size < *first_bytes) {
+      throw InputError(fmt::format("{}: holds fewer than the {} bytes to be read", file.string(), *first_bytes));
+    }
     std::string bytes(static_cast<size_t>(*first_bytes), '\0');
     whole.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     if (static_cast<std::uintmax_t>(whole.gcount()) != *first_bytes) {
