@@ -21,7 +21,7 @@ cmake --build "$build_dir" --parallel "${JOBS:-2}"
 
 source scripts/sanitizer_env.sh
 targets=("$@")
-((${#targets[@]})) || targets=(fuzz_config fuzz_data_defined fuzz_stimulus_log fuzz_parameter_vector fuzz_tracker_state fuzz_pose_table fuzz_dicom)
+((${#targets[@]})) || targets=(fuzz_config fuzz_data_defined fuzz_stimulus_log fuzz_parameter_vector fuzz_tracker_state fuzz_pose_table fuzz_dicom fuzz_image_header)
 mkdir -p "$build_dir/artifacts"
 status=0
 for t in "${targets[@]}"; do

@@ -267,6 +267,17 @@ TEST(FrameSource, EachPageOfATiffStackIsAFrame) {
   }
   EXPECT_EQ(n, 3);
 
+  // Pages of another size than the sensor's: the first page's header says
+  // so, before a block of pages is decoded.
+  try {
+    gtrack::open_frame_source(stack.string(), {64, 48}, {}, 25);
+    FAIL() << "a stack of another size was opened";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stack.TIF: image is 128x96 but the sensor expects 64x48"),
+              std::string::npos)
+        << e.what();
+  }
+
   // A page of another size is named; a file that is no TIFF is one line.
   pages[4] = cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(9));
   ASSERT_TRUE(cv::imwritemulti(stack.string(), pages));
@@ -601,8 +612,10 @@ TEST(FrameSource, AFloatImageIsRefusedNamingIt) {
   }
 }
 
-// A PNG whose header claims 60000 x 60000 pixels (68 bytes in all): OpenCV
-// refuses it with an assertion; the error is one line naming the file.
+// A PNG whose header claims 60000 x 60000 pixels (68 bytes in all): its
+// size is refused from its header, before it is decoded; for a sensor of
+// that size, OpenCV refuses it with an assertion. Either error is one line
+// naming the file.
 TEST(FrameSource, AnImageWhoseHeaderIsTooLargeIsRefusedNamingIt) {
   const fs::path dir = folder_of("header_too_large", {});
   const unsigned char png[] = {
@@ -611,14 +624,70 @@ TEST(FrameSource, AnImageWhoseHeaderIsTooLargeIsRefusedNamingIt) {
       0x00, 0x00, 0x0b, 0x49, 0x44, 0x41, 0x54, 0x78, 0xda, 0x63, 0x60, 0x40, 0x06, 0x00, 0x00, 0x0e, 0x00,
       0x01, 0x3a, 0x35, 0x04, 0x56, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
   std::ofstream(dir / "000000.png", std::ios::binary).write(reinterpret_cast<const char*>(png), sizeof png);
-  auto src = gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25);
   try {
-    src->next();
+    gtrack::open_frame_source(dir.string(), {8, 8}, {}, 25)->next();
+    FAIL() << "an image of 60000 x 60000 pixels was read";
+  } catch (const gtrack::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("000000.png: image is 60000x60000 but the sensor expects 8x8"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  try {
+    gtrack::open_frame_source(dir.string(), {60000, 60000}, {}, 25)->next();
     FAIL() << "an image of 60000 x 60000 pixels was read";
   } catch (const gtrack::InputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("000000.png: cannot read the image"), std::string::npos) << what;
     EXPECT_NE(what.find("its header gives a size above the 2^30 pixels OpenCV decodes"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+// An image of another size than the sensor's is refused from its header,
+// before its pixels are decoded: each kind cut right after its header
+// (which no decoder reads) gives the size it says. The same cut at the
+// sensor's size is left to the decoder, which cannot read it.
+TEST(FrameSource, AnImageOfAnotherSizeIsRefusedFromItsHeader) {
+  const fs::path dir = folder_of("header_size", {});
+  cv::Mat img(30, 40, CV_8UC3);
+  cv::randu(img, 0, 255);
+  const auto bytes_of = [&](const std::string& ext) {
+    std::vector<uchar> buf;
+    EXPECT_TRUE(cv::imencode(ext, ext == ".pgm" ? cv::Mat(30, 40, CV_8UC1, cv::Scalar(7)) : img, buf));
+    return std::string(buf.begin(), buf.end());
+  };
+  // Where each header ends: PNG's IHDR chunk; JPEG's frame header (SOF0);
+  // BMP's file and info headers; PGM's text header.
+  const std::string jpeg = bytes_of(".jpg");
+  const size_t sof = jpeg.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  const std::vector<std::pair<std::string, std::string>> cut = {
+      {"a.png", bytes_of(".png").substr(0, 33)},
+      {"a.jpg", jpeg.substr(0, sof + 9)},
+      {"a.bmp", bytes_of(".bmp").substr(0, 54)},
+      {"a.pgm", bytes_of(".pgm").substr(0, 13)},
+  };
+  for (const auto& [name, bytes] : cut) {
+    const fs::path one = dir / name.substr(2);
+    fs::create_directories(one);
+    std::ofstream(one / name, std::ios::binary) << bytes;
+    try {
+      gtrack::open_frame_source(one.string(), {64, 48}, {}, 25)->next();
+      FAIL() << name << ": read";
+    } catch (const gtrack::InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(name + ": image is 40x30 but the sensor expects 64x48"), std::string::npos) << what;
+    }
+    // The sensor's size, or the same turned (an orientation tag may turn
+    // a decoded image): the decoder has the last word.
+    for (const gtrack::ImageSize sensor : {gtrack::ImageSize{40, 30}, gtrack::ImageSize{30, 40}}) {
+      try {
+        if (auto f = gtrack::open_frame_source(one.string(), sensor, {}, 25)->next()) {
+          EXPECT_EQ(f->image.cols, sensor.width) << name;  // a decoder that takes what it has
+        }
+      } catch (const gtrack::InputError& e) {
+        EXPECT_EQ(std::string(e.what()).find("image is 40x30"), std::string::npos) << e.what();
+      }
+    }
   }
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <climits>
 #include <cmath>
 #include <cstdarg>
 #include <cstdint>
@@ -28,6 +29,7 @@
 
 #include "captured_stderr.hpp"
 #include "dicom.hpp"
+#include "image_header.hpp"
 #include "input_kind.hpp"
 #include "video_backend.hpp"
 #include "gtrack/error.hpp"
@@ -112,12 +114,16 @@ namespace {
 
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
-void check_size(const cv::Mat& img, ImageSize expected, const std::string& what) {
-  if (img.cols != expected.width || img.rows != expected.height) {
-    throw InputError(what + ": image is " + size_text(img.cols, img.rows) + " but the sensor expects " +
+void check_size(ImageSize got, ImageSize expected, const std::string& what) {
+  if (got.width != expected.width || got.height != expected.height) {
+    throw InputError(what + ": image is " + size_text(got.width, got.height) + " but the sensor expects " +
                      size_text(expected.width, expected.height) +
                      " (the size [sensor] gives: its width/height, or its calibration file's image size)");
   }
+}
+
+void check_size(const cv::Mat& img, ImageSize expected, const std::string& what) {
+  check_size(ImageSize{img.cols, img.rows}, expected, what);
 }
 
 // ".TIF" -> ".tif": extensions are matched whatever their case.
@@ -503,6 +509,36 @@ bool is_dicom_name(const fs::path& p) {
   // A folder lists no other file without an extension.
   return detail::has_dicom_extension(p.string()) || p.extension().empty();
 }
+
+// An image whose header gives the sensor's size in neither orientation is
+// refused before it is decoded (a JPEG's or TIFF's orientation tag may turn
+// the decoded image: that one is judged once decoded).
+// The size an image file's header gives (a TIFF's first page's, read by
+// libtiff), or nullopt.
+std::optional<ImageSize> header_size(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  if (!detail::is_tiff(in)) return detail::image_header_size(in);
+  in.close();
+  detail::CapturedStderr library;  // libtiff's words about private tags or a file cut short
+  TIFF* tif = TIFFOpen(file.c_str(), "r");
+  if (!tif) return std::nullopt;
+  std::uint32_t width = 0, height = 0;
+  const bool read = TIFFGetField(tif, TIFFTAG_IMAGEWIDTH, &width) == 1 &&
+                    TIFFGetField(tif, TIFFTAG_IMAGELENGTH, &height) == 1;
+  TIFFClose(tif);
+  if (!read || width == 0 || height == 0 || width > INT_MAX || height > INT_MAX) return std::nullopt;
+  return ImageSize{static_cast<int>(width), static_cast<int>(height)};
+}
+
+void check_header_size(const fs::path& file, ImageSize expected) {
+  if (is_dicom_name(file)) return;  // its preamble may hold another format's header
+  const std::optional<ImageSize> header = header_size(file);
+  if (header && !(header->width == expected.height && header->height == expected.width)) {
+    check_size(*header, expected, file.string());
+  }
+}
+
 cv::Mat read_dicom_image(const fs::path& p, std::string& said) {
   try {
     std::ifstream in(p, std::ios::binary);
@@ -790,6 +826,7 @@ class FolderSource final : public FrameSource {
     };
     std::string said;
     if (!following()) {
+      check_header_size(p, expected_);
       ReadImage got;
       got.image = decode(said);
       if (got.image.empty()) fail_to_read(p, said);
@@ -815,6 +852,7 @@ class FolderSource final : public FrameSource {
       // whose file times step by seconds, changes neither as it fills.
       if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time ||
           std::chrono::steady_clock::now() - decoded_at > std::chrono::seconds(2)) {
+        check_header_size(p, expected_);  // once whole, the header says what the image will be
         img = decode(said);
         decoded = true;
         decoded_size = size;
@@ -1007,6 +1045,7 @@ class StackSource final : public FrameSource {
       count_ = pages;
       return;
     }
+    check_header_size(spec_, expected_);  // its first page's, before a block of pages is decoded
     std::string said;
     {
       detail::CapturedStderr library;  // libtiff's warnings about private tags (ImageJ's, OME's)
@@ -1178,6 +1217,7 @@ class DicomSource final : public FrameSource {
       : spec_(std::move(spec)), expected_(expected), filter_(range), in_(spec_, std::ios::binary) {
     if (!in_) throw InputError(spec_ + ": cannot open the file");
     layout_ = detail::read_dicom_layout(in_, spec_);
+    if (layout_.rows > 0 && layout_.columns > 0) check_size(ImageSize{layout_.columns, layout_.rows}, expected, spec_);
     // The frames' times at the fallback rate when the file gives none; its
     // fps() says 0 then, as a folder's does.
     time_fps_ = layout_.fps > 0 ? layout_.fps : fallback_fps;
