@@ -99,11 +99,21 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
                                           "unoccluded, no allowance", "unoccluded, an allowance left",
                                           fmt::format("tilt margin < {}", gtrack::kNarrowTiltMargin),
                                           fmt::format("tilt margin >= {}", gtrack::kNarrowTiltMargin)};
+  // By kind of frame: a gripper partly out of view coming in or going out
+  // (its share in view larger or smaller than at the frame before), and one
+  // wholly in view within kAfterReturn frames of a return into view, where
+  // a track started from what showed first is still settling.
+  constexpr int kAfterReturn = 20;
+  const std::vector<std::string> kind = {"partly out of view, coming in", "partly out of view, going out",
+                                         fmt::format("in view, <= {} frames after a return", kAfterReturn)};
   std::map<std::string, int> other_branch;  // frames on the other branch of the tilt's sign, per group
   // With the truth scored (--score-truth): is the search or the cost short?
   const std::vector<std::string> why = {"truth scores lower", "truth spills over allowance", "truth scores no lower"};
   bool have_occlusion = false;
-  for (const auto& f : ev.per_frame) {
+  std::optional<int> last_out;  // the last frame out of view
+  for (std::size_t i = 0; i < ev.per_frame.size(); ++i) {
+    const gtrack::FrameEvaluation& f = ev.per_frame[i];
+    if (f.out_of_view) last_out = f.frame;
     if (f.out_of_view || !f.has_estimate || f.lost) continue;
     const auto r = rows.find(f.frame);
     if (r == rows.end()) continue;
@@ -113,6 +123,14 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     std::string g = *occluded < 0.01 ? order[0] : *occluded < 0.4 ? order[1] : order[2];
     if (f.in_view < 0.99) g = order[3];
     groups[g].add(f.errors);
+    if (g == order[3]) {
+      // At the first frame, against the next.
+      const bool coming_in = i > 0 ? ev.per_frame[i - 1].in_view < f.in_view
+                                   : i + 1 < ev.per_frame.size() && ev.per_frame[i + 1].in_view > f.in_view;
+      groups[coming_in ? kind[0] : kind[1]].add(f.errors);
+    } else if (last_out && f.frame - *last_out <= kAfterReturn) {
+      groups[kind[2]].add(f.errors);
+    }
     const auto s = scores.find(f.frame);
     if (g == order[0] && s != scores.end()) groups[s->second.allowance > 0 ? order[5] : order[4]].add(f.errors);
     if (s != scores.end() && s->second.tilt_margin) {
@@ -146,19 +164,35 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
   };
   double inplane_total = 0;
   for (const auto& name : why) inplane_total += inplane_sum(name);
-  std::vector<std::string> all = order;
+  // The occlusion groups split every frame: each kind's share of their
+  // summed orientation error.
+  const auto orientation_sum = [&](const std::string& name) {
+    const auto it = groups.find(name);
+    return it == groups.end() ? 0.0 : it->second.orientation_deg.mean * it->second.orientation_deg.count;
+  };
+  double orientation_total = 0;
+  for (int k = 0; k < 4; ++k) orientation_total += orientation_sum(order[static_cast<std::size_t>(k)]);
+  std::vector<std::string> all(order.begin(), order.begin() + 4);
+  all.insert(all.end(), kind.begin(), kind.end());
+  all.insert(all.end(), order.begin() + 4, order.end());
   all.insert(all.end(), why.begin(), why.end());
   for (const auto& name : all) {
     auto it = groups.find(name);
     if (it == groups.end()) continue;
     const gtrack::ErrorSet& e = it->second;
-    std::cout << "    " << std::left << std::setw(30) << name << std::right << std::setw(5)
+    std::cout << "    " << std::left << std::setw(38) << name << std::right << std::setw(5)
               << e.position_inplane_um.count << " frames  in-plane " << std::setprecision(1) << std::setw(7)
               << e.position_inplane_um.mean << " um (median " << e.position_inplane_um.median << ")  orientation "
               << std::setw(5) << e.orientation_deg.mean << " deg (median " << e.orientation_deg.median
               << ")  joints " << std::setprecision(2) << e.joint_deg.mean << " deg";
     if (const auto b = other_branch.find(name); b != other_branch.end()) {
       std::cout << "  (" << b->second << " on the other branch of the tilt's sign)";
+    }
+    const bool by_kind = std::find(all.begin(), all.begin() + 4 + static_cast<std::ptrdiff_t>(kind.size()), name) !=
+                         all.begin() + 4 + static_cast<std::ptrdiff_t>(kind.size());
+    if (by_kind && orientation_total > 0) {
+      std::cout << "  (" << std::setprecision(0) << 100 * orientation_sum(name) / orientation_total
+                << " % of the summed orientation error)";
     }
     if (std::find(why.begin(), why.end(), name) != why.end() && inplane_total > 0) {
       std::cout << "  (" << std::setprecision(0) << 100 * inplane_sum(name) / inplane_total
@@ -406,7 +440,9 @@ GTRACK_COMMAND(
           "config,c", po::value<std::string>(), "config naming the gripper (default: sequence.toml beside the truth)")(
           "json", po::value<std::string>(), "write the summary as JSON")(
           "per-frame", po::value<std::string>(), "write per-frame errors as CSV")(
-          "breakdown", "also the errors by how much of the gripper was hidden, of unoccluded frames by "
+          "breakdown", "also the errors by how much of the gripper was hidden, of a gripper partly out of view by "
+                       "whether it is coming in or going out, of the frames just after a return into view, of "
+                       "unoccluded frames by "
                        "whether an occlusion allowance was left over, and (after 'gtrack track --score-truth') by "
                        "whether the truth scored lower than the estimate")(
           "out-of-view-below", po::value<double>()->default_value(0.1, "0.1"),

@@ -989,6 +989,31 @@ TEST(Cli, EvalRefusesMalformedTables) {
   EXPECT_NE(r.output.find("2 rows are for frames"), std::string::npos) << r.output;
 }
 
+// The rows of eval --breakdown: per group, its frames and the share of the
+// summed orientation error it says (-1 when it says none).
+struct BreakdownRow {
+  int frames = 0;
+  int orientation_share = -1;
+};
+std::map<std::string, BreakdownRow> breakdown_rows(const std::string& output) {
+  std::map<std::string, BreakdownRow> rows;
+  std::istringstream lines_in(output);
+  for (std::string l; std::getline(lines_in, l);) {
+    const auto at = l.find(" frames  in-plane");
+    if (at == std::string::npos) continue;
+    const auto digits = l.find_last_not_of("0123456789", at - 1);
+    std::string name = l.substr(0, digits + 1);
+    name = name.substr(name.find_first_not_of(' '));
+    name = name.substr(0, name.find_last_not_of(' ') + 1);
+    BreakdownRow& row = rows[name];
+    row.frames = std::stoi(l.substr(digits + 1, at - digits - 1));
+    if (const auto share = l.find(" % of the summed orientation error"); share != std::string::npos) {
+      row.orientation_share = std::stoi(l.substr(l.rfind('(', share) + 1));
+    }
+  }
+  return rows;
+}
+
 // eval --breakdown: every in-view frame with an estimate falls in exactly
 // one occlusion group, the unoccluded ones again by the allowance, those
 // with a tilt margin by it, and, with the truth scored by the track
@@ -1015,16 +1040,7 @@ TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   int evaluated = -1;  // in view, with a usable estimate (lost frames are not)
   ASSERT_EQ(std::sscanf(r.output.c_str(), "frames %*d: %*d in view (%d evaluated", &evaluated), 1) << r.output;
   std::map<std::string, int> groups;
-  std::istringstream lines_in(r.output);
-  for (std::string l; std::getline(lines_in, l);) {
-    const auto at = l.find(" frames  in-plane");
-    if (at == std::string::npos) continue;
-    const auto digits = l.find_last_not_of("0123456789", at - 1);
-    std::string name = l.substr(0, digits + 1);
-    name = name.substr(name.find_first_not_of(' '));
-    name = name.substr(0, name.find_last_not_of(' ') + 1);
-    groups[name] = std::stoi(l.substr(digits + 1, at - digits - 1));
-  }
+  for (const auto& [name, row] : breakdown_rows(r.output)) groups[name] = row.frames;
   int occlusion = 0;
   for (const char* g : {"unoccluded", "< 40 % hidden", ">= 40 % hidden", "partly out of view"}) occlusion += groups[g];
   EXPECT_EQ(occlusion, evaluated) << r.output;
@@ -1043,6 +1059,64 @@ TEST(Cli, EvalBreakdownGroupsEveryEvaluatedFrameOnce) {
   const int by_margin = groups["tilt margin < 0.1"] + groups["tilt margin >= 0.1"];
   EXPECT_GT(by_margin, 0) << r.output;
   EXPECT_LE(by_margin, std::min(checked, evaluated)) << r.output;
+}
+
+// eval --breakdown by kind of frame, on a truth whose shares in view are
+// set by hand: a gripper going out (frames 5-7), out of view (8-10),
+// coming back in (11-13), then wholly in view; the estimates are the truth
+// turned by 10 degrees about the line of sight while it comes in, by 2
+// elsewhere. Each frame partly out of view is coming in or going out, the
+// 20 frames after the last one out of view are counted apart, and the
+// shares of the orientation error follow from the errors (30 and 6 of 88).
+TEST(Cli, EvalBreakdownSaysWhereTheGripperComesBackIntoView) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "breakdown_returns";
+  fs::remove_all(dir);
+  ASSERT_EQ(gtrack("synth --frames 35 --seed 6 --out " + dir.string()).code, 0);
+  const std::vector<double> going_out = {0.8, 0.5, 0.2}, coming_in = {0.3, 0.6, 0.9};
+  const auto share_in_view = [&](int frame) {
+    if (frame >= 5 && frame <= 7) return going_out[static_cast<std::size_t>(frame - 5)];
+    if (frame >= 8 && frame <= 10) return 0.05;
+    if (frame >= 11 && frame <= 13) return coming_in[static_cast<std::size_t>(frame - 11)];
+    return 1.0;
+  };
+  std::string truth, estimates;
+  {
+    std::stringstream in(read_file(dir / "ground_truth.csv"));
+    std::string l;
+    std::getline(in, l);
+    truth = l + "\n";
+    estimates = l.substr(0, l.rfind(",visible")) + "\n";
+    for (int frame = 0; std::getline(in, l); ++frame) {
+      std::vector<std::string> cells;
+      std::stringstream row(l);
+      for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+      ASSERT_EQ(cells.size(), 16u) << l;
+      const double v = share_in_view(frame);
+      cells[13] = cells[14] = std::to_string(v);  // visible, in_view
+      cells[15] = "0";                            // occluded
+      for (std::size_t k = 0; k < cells.size(); ++k) truth += (k ? "," : "") + cells[k];
+      truth += "\n";
+      cells[6] = std::to_string(std::stod(cells[6]) + (frame >= 11 && frame <= 13 ? 10.0 : 2.0));  // rz
+      for (std::size_t k = 0; k < 13; ++k) estimates += (k ? "," : "") + cells[k];
+      estimates += "\n";
+    }
+  }
+  std::ofstream(dir / "truth.csv") << truth;
+  std::ofstream(dir / "estimates.csv") << estimates;
+  const CliRun r = gtrack("eval -c " + (dir / "sequence.toml").string() + " -t " + (dir / "truth.csv").string() +
+                          " -e " + (dir / "estimates.csv").string() + " --breakdown");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("frames 35: 32 in view (32 evaluated"), std::string::npos) << r.output;
+  auto rows = breakdown_rows(r.output);
+  EXPECT_EQ(rows["unoccluded"].frames, 26) << r.output;
+  EXPECT_EQ(rows["partly out of view"].frames, 6) << r.output;
+  EXPECT_EQ(rows["partly out of view, coming in"].frames, 3) << r.output;
+  EXPECT_EQ(rows["partly out of view, going out"].frames, 3) << r.output;
+  EXPECT_EQ(rows["in view, <= 20 frames after a return"].frames, 17) << r.output;  // frames 14-30
+  EXPECT_EQ(rows["partly out of view, coming in"].orientation_share, 34) << r.output;  // 30 of 88
+  EXPECT_EQ(rows["partly out of view, going out"].orientation_share, 7) << r.output;   // 6 of 88
+  EXPECT_EQ(rows["in view, <= 20 frames after a return"].orientation_share, 39) << r.output;  // 34 of 88
+  EXPECT_EQ(rows["unoccluded"].orientation_share + rows["partly out of view"].orientation_share, 100) << r.output;
 }
 
 // --two-pass: the recording is tracked again backwards, and each frame of
