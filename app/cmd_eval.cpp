@@ -188,8 +188,8 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     if (const auto b = other_branch.find(name); b != other_branch.end()) {
       std::cout << "  (" << b->second << " on the other branch of the tilt's sign)";
     }
-    const bool by_kind = std::find(all.begin(), all.begin() + 4 + static_cast<std::ptrdiff_t>(kind.size()), name) !=
-                         all.begin() + 4 + static_cast<std::ptrdiff_t>(kind.size());
+    const bool by_kind = std::find(order.begin(), order.begin() + 4, name) != order.begin() + 4 ||
+                         std::find(kind.begin(), kind.end(), name) != kind.end();
     if (by_kind && orientation_total > 0) {
       std::cout << "  (" << std::setprecision(0) << 100 * orientation_sum(name) / orientation_total
                 << " % of the summed orientation error)";

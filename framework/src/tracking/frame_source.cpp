@@ -510,9 +510,6 @@ bool is_dicom_name(const fs::path& p) {
   return detail::has_dicom_extension(p.string()) || p.extension().empty();
 }
 
-// An image whose header gives the sensor's size in neither orientation is
-// refused before it is decoded (a JPEG's or TIFF's orientation tag may turn
-// the decoded image: that one is judged once decoded).
 // The size an image file's header gives (a TIFF's first page's, read by
 // libtiff), or nullopt.
 std::optional<ImageSize> header_size(const fs::path& file) {
@@ -531,6 +528,9 @@ std::optional<ImageSize> header_size(const fs::path& file) {
   return ImageSize{static_cast<int>(width), static_cast<int>(height)};
 }
 
+// An image whose header gives the sensor's size in neither orientation is
+// refused before it is decoded (a JPEG's or TIFF's orientation tag may turn
+// the decoded image: that one is judged once decoded).
 void check_header_size(const fs::path& file, ImageSize expected) {
   if (is_dicom_name(file)) return;  // its preamble may hold another format's header
   const std::optional<ImageSize> header = header_size(file);
