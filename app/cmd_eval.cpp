@@ -170,11 +170,12 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     const auto it = groups.find(name);
     return it == groups.end() ? 0.0 : it->second.orientation_deg.mean * it->second.orientation_deg.count;
   };
+  const auto occlusion_end = order.begin() + 4;  // unoccluded .. partly out of view
   double orientation_total = 0;
-  for (int k = 0; k < 4; ++k) orientation_total += orientation_sum(order[static_cast<std::size_t>(k)]);
-  std::vector<std::string> all(order.begin(), order.begin() + 4);
+  for (auto g = order.begin(); g != occlusion_end; ++g) orientation_total += orientation_sum(*g);
+  std::vector<std::string> all(order.begin(), occlusion_end);
   all.insert(all.end(), kind.begin(), kind.end());
-  all.insert(all.end(), order.begin() + 4, order.end());
+  all.insert(all.end(), occlusion_end, order.end());
   all.insert(all.end(), why.begin(), why.end());
   for (const auto& name : all) {
     auto it = groups.find(name);
@@ -188,7 +189,7 @@ void print_breakdown(const gtrack::Evaluation& ev, const gtrack::PoseTable& trut
     if (const auto b = other_branch.find(name); b != other_branch.end()) {
       std::cout << "  (" << b->second << " on the other branch of the tilt's sign)";
     }
-    const bool by_kind = std::find(order.begin(), order.begin() + 4, name) != order.begin() + 4 ||
+    const bool by_kind = std::find(order.begin(), occlusion_end, name) != occlusion_end ||
                          std::find(kind.begin(), kind.end(), name) != kind.end();
     if (by_kind && orientation_total > 0) {
       std::cout << "  (" << std::setprecision(0) << 100 * orientation_sum(name) / orientation_total

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
-#include <climits>
 #include <cmath>
 #include <cstdarg>
 #include <cstdint>
@@ -510,30 +509,13 @@ bool is_dicom_name(const fs::path& p) {
   return detail::has_dicom_extension(p.string()) || p.extension().empty();
 }
 
-// The size an image file's header gives (a TIFF's first page's, read by
-// libtiff), or nullopt.
-std::optional<ImageSize> header_size(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
-  if (!detail::is_tiff(in)) return detail::image_header_size(in);
-  in.close();
-  detail::CapturedStderr library;  // libtiff's words about private tags or a file cut short
-  TIFF* tif = TIFFOpen(file.c_str(), "r");
-  if (!tif) return std::nullopt;
-  std::uint32_t width = 0, height = 0;
-  const bool read = TIFFGetField(tif, TIFFTAG_IMAGEWIDTH, &width) == 1 &&
-                    TIFFGetField(tif, TIFFTAG_IMAGELENGTH, &height) == 1;
-  TIFFClose(tif);
-  if (!read || width == 0 || height == 0 || width > INT_MAX || height > INT_MAX) return std::nullopt;
-  return ImageSize{static_cast<int>(width), static_cast<int>(height)};
-}
-
 // An image whose header gives the sensor's size in neither orientation is
 // refused before it is decoded (a JPEG's or TIFF's orientation tag may turn
 // the decoded image: that one is judged once decoded).
 void check_header_size(const fs::path& file, ImageSize expected) {
   if (is_dicom_name(file)) return;  // its preamble may hold another format's header
-  const std::optional<ImageSize> header = header_size(file);
+  std::ifstream in(file, std::ios::binary);
+  const std::optional<ImageSize> header = in ? detail::image_header_size(in) : std::nullopt;
   if (header && !(header->width == expected.height && header->height == expected.width)) {
     check_size(*header, expected, file.string());
   }

@@ -84,6 +84,33 @@ std::optional<ImageSize> pnm_size(std::istream& in) {
   return sized(values[0], values[1]);
 }
 
+// A classic TIFF's first page: ImageWidth (256) and ImageLength (257) in
+// its first directory, SHORT or LONG, in the file's byte order (a SHORT
+// value sits in the first two bytes of its entry's value field).
+std::optional<ImageSize> tiff_size(std::istream& in, bool little) {
+  const auto read = [&](std::uint64_t at, int n) -> std::optional<std::uint32_t> {
+    unsigned char v[4];
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(v), n)) return std::nullopt;
+    return little ? little_endian(v, n) : big_endian(v, n);
+  };
+  const auto directory = read(4, 4);
+  const auto entries = directory ? read(*directory, 2) : std::nullopt;
+  if (!entries) return std::nullopt;
+  std::uint64_t width = 0, height = 0;
+  for (std::uint32_t i = 0; i < *entries && !(width && height); ++i) {
+    const std::uint64_t entry = std::uint64_t{*directory} + 2 + 12 * std::uint64_t{i};
+    const auto tag = read(entry, 2), type = read(entry + 2, 2);
+    if (!tag || !type) return std::nullopt;
+    if ((*tag != 256 && *tag != 257) || (*type != 3 && *type != 4)) continue;
+    const auto value = read(entry + 8, *type == 3 ? 2 : 4);
+    if (!value) return std::nullopt;
+    (*tag == 256 ? width : height) = *value;
+  }
+  return sized(width, height);
+}
+
 }  // namespace
 
 std::optional<ImageSize> image_header_size(std::istream& in) {
@@ -107,18 +134,9 @@ std::optional<ImageSize> image_header_size(std::istream& in) {
     return sized(little_endian(b.data() + 18, 4), height < 0 ? -static_cast<std::int64_t>(height) : height);
   }
   if (b[0] == 'P' && b[1] >= '1' && b[1] <= '6') return pnm_size(in);
+  if (got >= 8 && b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0) return tiff_size(in, true);
+  if (got >= 8 && b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42) return tiff_size(in, false);
   return std::nullopt;
-}
-
-bool is_tiff(std::istream& in) {
-  char b[4] = {};
-  in.read(b, 4);
-  const bool tiff = in.gcount() == 4 && ((b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0) ||
-                                         (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43)) ||
-                                         (b[0] == 'I' && b[1] == 'I' && b[2] == 43 && b[3] == 0));
-  in.clear();
-  in.seekg(0);
-  return tiff;
 }
 
 }  // namespace gtrack::detail
