@@ -3,6 +3,7 @@
 //   6b: joint error when every hinge deviates from its finger's value by
 //       Gaussian noise of sd sigma (the model assumes they are equal).
 // Writes fig6a.csv / fig6b.csv and plots of them drawn with OpenCV.
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -27,16 +28,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// "8,16,32": each item a whole decimal number (spaces around it allowed);
+// "8;16", "8abc" or "0x5" are refused, not read as their first number.
 std::vector<double> parse_list(const std::string& text, const char* option) {
   std::vector<double> out;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    try {
-      out.push_back(std::stod(item));
-    } catch (...) {
-      throw gtrack::cli::UsageError(std::string("--") + option + ": '" + item + "' is not a number");
+    const size_t first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+    const std::string trimmed = first == std::string::npos ? std::string() : item.substr(first, last - first + 1);
+    double value = 0;
+    const char* begin = trimmed.data() + (trimmed.rfind('+', 0) == 0 ? 1 : 0);
+    const char* end = trimmed.data() + trimmed.size();
+    const auto [ptr, ec] = std::from_chars(begin, end, value, std::chars_format::general);
+    if (trimmed.empty() || ec != std::errc() || ptr != end || !std::isfinite(value)) {
+      throw gtrack::cli::UsageError(std::string("--") + option + ": '" + item +
+                                    "' is not a number (expected numbers separated by commas, e.g. 8,16,32)");
     }
+    out.push_back(value);
   }
   if (out.empty()) throw gtrack::cli::UsageError(std::string("--") + option + " needs at least one value");
   return out;
@@ -108,24 +117,35 @@ void plot(const fs::path& file, const std::string& title, const std::string& xla
 struct Context {
   gtrack::cli::CommonOptions common;
   fs::path config, out;
+  std::vector<gtrack::NamedFile> named_files;  // the files the config names (a gripper's model file, ...)
   gtrack::SynthOptions synth;
   int sequences = 1;
 };
 
-// What a cached sequence was made from: the config's text and the synth
-// options. A sequence is reused only when they are the same, so that a
-// sweep run again in the same --out with another config, preset or length
-// does not score the old sequences.
-std::string sequence_recipe(const Context& c, std::uint64_t seed, double noise) {
-  std::ifstream in(c.config, std::ios::binary);
+// A hash of a file's bytes ("missing" when it cannot be read).
+std::string content_hash(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return "missing";
   std::ostringstream text;
   text << in.rdbuf();
+  return std::to_string(std::hash<std::string>{}(text.str()));
+}
+
+// What a cached sequence was made from: the config's text, the files it
+// names (a gripper's model file, ...) and the synth options. A sequence is
+// reused only when they are the same, so that a sweep run again in the same
+// --out with another config, model, preset or length does not score the old
+// sequences.
+std::string sequence_recipe(const Context& c, std::uint64_t seed, double noise) {
   char line[256];
   std::snprintf(line, sizeof line, "frames %d\npreset %s\nseed %llu\nnoise %.17g\nocclusion_scale %.17g\n",
                 c.synth.frames, c.synth.preset.c_str(), static_cast<unsigned long long>(seed), noise,
                 c.synth.occlusion_scale);
-  return "config " + fs::absolute(c.config).string() + "\nconfig_hash " +
-         std::to_string(std::hash<std::string>{}(text.str())) + "\n" + line;
+  std::string recipe = "config " + fs::absolute(c.config).string() + "\nconfig_hash " + content_hash(c.config) + "\n";
+  for (const gtrack::NamedFile& f : c.named_files) {
+    recipe += "file " + f.dotted() + " " + fs::absolute(f.path).string() + " " + content_hash(f.path) + "\n";
+  }
+  return recipe + line;
 }
 
 fs::path make_sequence(const Context& c, std::uint64_t seed, double noise) {
@@ -199,11 +219,33 @@ Cell run_cell(const Context& c, double noise, int particles, int generations) {
   return cell;
 }
 
-void write_row(std::ofstream& csv, const std::string& head, const Cell& c) {
-  csv << head << "," << c.frames << "," << c.endpoint << "," << c.endpoint_sd << "," << c.inplane << "," << c.depth
-      << "," << c.orientation << "," << c.joints << "," << c.joints_sd << "," << c.lost << "," << c.fps << "\n";
-  csv.flush();
-}
+// A figure's CSV, each row on disk as soon as its cell is measured.
+class FigureCsv {
+ public:
+  FigureCsv(fs::path file, const std::string& header) : file_(std::move(file)), out_(file_) {
+    if (!out_) fail("cannot open for writing");
+    out_ << header << "\n";
+    flush();
+  }
+  void row(const std::string& head, const Cell& c) {
+    out_ << head << "," << c.frames << "," << c.endpoint << "," << c.endpoint_sd << "," << c.inplane << "," << c.depth
+         << "," << c.orientation << "," << c.joints << "," << c.joints_sd << "," << c.lost << "," << c.fps << "\n";
+    flush();
+  }
+
+ private:
+  void flush() {
+    out_.flush();
+    if (!out_) fail("cannot write (is the disk full?)");
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    std::error_code ec;
+    throw gtrack::InputError(file_.string() + ": " + what +
+                             (fs::is_directory(file_, ec) ? " (it is a folder; expected a file)" : ""));
+  }
+  fs::path file_;
+  std::ofstream out_;
+};
 
 const char* kColumns =
     "frames,endpoint_um,endpoint_um_sd,inplane_um,depth_um,orientation_deg,joint_deg,joint_deg_sd,lost_in_view,"
@@ -263,21 +305,21 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
     const gtrack::Setup setup = gtrack::load_setup(c.config, so);
     const gtrack::ObservationConfig bounds = gtrack::engine_config(setup).observation;
     gtrack::check_root_keys(setup);
+    c.named_files = setup.root.named_files();
     // A config without --preset: sequences its bounds can track, as synth makes.
     c.synth.preset = gtrack::cli::synth_preset_for(vm, c.config, setup, bounds);
   }
   gtrack::cli::make_output_folder(c.out, "out");
 
   if (which != "6b") {
-    std::ofstream csv(c.out / "fig6a.csv");
-    csv << "particles,generations," << kColumns << "\n";
+    FigureCsv csv(c.out / "fig6a.csv", std::string("particles,generations,") + kColumns);
     std::vector<Series> series;
     for (double g : generations) {
       Series s;
       s.label = "G = " + std::to_string(static_cast<int>(g));
       for (double n : particles) {
         const Cell cell = run_cell(c, 0, static_cast<int>(n), static_cast<int>(g));
-        write_row(csv, std::to_string(int(n)) + "," + std::to_string(int(g)), cell);
+        csv.row(std::to_string(int(n)) + "," + std::to_string(int(g)), cell);
         if (cell.judged == 0) {
           std::printf("6a  N=%3d G=%3d  no frame to judge: lost %d of %d  %.1f frames/s\n", int(n), int(g), cell.lost,
                       cell.frames, cell.fps);
@@ -298,15 +340,14 @@ int run_sweep(const gtrack::cli::CommonOptions& common, const po::variables_map&
   }
   if (which != "6a") {
     const int n = vm["fig6b-particles"].as<int>(), g = vm["fig6b-generations"].as<int>();
-    std::ofstream csv(c.out / "fig6b.csv");
-    csv << "sigma_deg,particles,generations," << kColumns << "\n";
+    FigureCsv csv(c.out / "fig6b.csv", std::string("sigma_deg,particles,generations,") + kColumns);
     Series s;
     s.label = "N=" + std::to_string(n) + " G=" + std::to_string(g);
     for (double sigma : sigmas) {
       const Cell cell = run_cell(c, sigma, n, g);
       char head[64];
       std::snprintf(head, sizeof head, "%g,%d,%d", sigma, n, g);
-      write_row(csv, head, cell);
+      csv.row(head, cell);
       if (cell.judged == 0) {
         std::printf("6b  sigma=%.2f deg  no frame to judge: lost %d of %d\n", sigma, cell.lost, cell.frames);
       } else {

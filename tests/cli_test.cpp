@@ -1285,6 +1285,64 @@ TEST(Cli, SweepChecksItsConfigAndFolderFirst) {
   r = gtrack("sweep" + tiny + " --out " + cfg.string() + "/x");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find(cfg.string() + "/x: cannot create the folder"), std::string::npos) << r.output;
+  // A list is numbers separated by commas: another separator, a number
+  // followed by text or a hexadecimal one is refused, not read as its first
+  // number.
+  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+           {"sigmas", "0.5 1"}, {"particles", "16;32"}, {"particles", "8abc"}, {"sigmas", "0x5"}, {"sigmas", "1,,2"}}) {
+    r = gtrack("sweep --" + option + " \"" + value + "\" --out " + dir.string());
+    EXPECT_EQ(r.code, 2) << value;
+    EXPECT_NE(r.output.find("--" + option + ": '"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("' is not a number (expected numbers separated by commas"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir));
+  r = gtrack("sweep --particles \" 4 , +6\" --generations 2 --frames 2 --figure 6a --out " + dir.string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(lines(read_file(dir / "fig6a.csv")), 1 + 2);
+  // A figure's table that cannot be written stops the sweep with its name.
+  fs::remove(dir / "fig6a.csv");
+  fs::create_directories(dir / "fig6a.csv");
+  r = gtrack("sweep --particles 4 --generations 2 --frames 2 --figure 6a --out " + dir.string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find((dir / "fig6a.csv").string() + ": cannot open for writing (it is a folder; expected a file)"),
+            std::string::npos)
+      << r.output;
+}
+
+// The sequences a sweep keeps are made again when a file its config names
+// (here a camera calibration) has changed since, not scored against the
+// old frames.
+TEST(Cli, SweepRemakesItsSequencesWhenAFileTheConfigNamesChanges) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_cli_test" / "sweep_files";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "lab");
+  const auto write_camera = [&](double f) {
+    cv::FileStorage camera((dir / "lab" / "camera.yml").string(), cv::FileStorage::WRITE);
+    camera << "image_width" << 256 << "image_height" << 256;
+    camera << "camera_matrix" << (cv::Mat_<double>(3, 3) << f, 0, 127.5, 0, f, 127.5, 0, 0, 1);
+    camera << "distortion_coefficients" << cv::Mat::zeros(1, 5, CV_64F);
+  };
+  write_camera(3200);
+  std::ofstream(dir / "lab" / "lab.toml")
+      << "[sensor]\nplugin = \"pinhole_microscope\"\nwidth = 256\nheight = 256\ncalibration = \"camera.yml\"\n"
+         "[gripper]\nplugin = \"hydrogel_six_finger\"\n[stimulus]\nplugin = \"temperature_hysteresis\"\n";
+  const std::string sweep = "sweep --config " + (dir / "lab" / "lab.toml").string() +
+                            " --particles 4 --generations 2 --frames 2 --figure 6a --out " + (dir / "out").string();
+  CliRun r = gtrack(sweep);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const fs::path made = dir / "out" / "sequences" / "seq_seed1_noise0" / "made_from.txt";
+  const std::string before = read_file(made);
+  EXPECT_NE(before.find("file sensor.calibration " + (dir / "lab" / "camera.yml").string() + " "), std::string::npos)
+      << before;
+  r = gtrack(sweep);  // nothing changed: the sequences are kept
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("making it again"), std::string::npos) << r.output;
+  write_camera(2800);
+  r = gtrack(sweep);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("seq_seed1_noise0 was made from other settings; making it again"), std::string::npos)
+      << r.output;
+  EXPECT_NE(read_file(made), before);
 }
 
 // A config that names a file by a relative path (a calibration beside it):

@@ -186,6 +186,17 @@ TEST(Dicom, AFolderOfSingleFrameFilesIsAFolderOfImages) {
   ASSERT_EQ(from_export.size(), 3u);
   EXPECT_TRUE(same(from_export[2], bgr(written[2])));
   EXPECT_FALSE(gtrack::open_frame_source(exported.string(), {40, 30}, {}, 30)->pixel_size_mm());
+  // An export that names its files by their UIDs: the last part of the
+  // name reads as an extension of digits. Each is looked at, in the order
+  // of its numbers; a text file so named is not an image.
+  const fs::path by_uid = dir_for("by_uid");
+  for (int i = 0; i < 3; ++i) {
+    write_dicom(by_uid / ("1.2.840.113619.2.55." + std::to_string(9 - 4 * i)), {written[static_cast<std::size_t>(2 - i)]});
+  }
+  std::ofstream(by_uid / "notes.2024") << "not an image";
+  const auto from_uids = read_all(by_uid, {40, 30});
+  ASSERT_EQ(from_uids.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(same(from_uids[i], bgr(written[i]))) << "frame " << i;
   // Its pixel size is its first file's, as a multi-frame file's is (a
   // folder's had gone unchecked against the sensor's).
   DicomWriteOptions region;

@@ -222,6 +222,97 @@ TEST(FrameSource, ATiffStackCutShortSaysWhereItsPagesEnd) {
   EXPECT_NE(said.find("cut.tif: its pages end after page"), std::string::npos) << said;
 }
 
+// A little-endian grey TIFF: a 128x96 page, then a 4x3 page whose
+// NewSubfileType is `second_type` (1: a reduced image, a thumbnail).
+std::string two_page_tiff(std::uint32_t second_type) {
+  std::string b;
+  const auto u16 = [&](std::uint32_t v) {
+    b.push_back(static_cast<char>(v & 255));
+    b.push_back(static_cast<char>((v >> 8) & 255));
+  };
+  const auto u32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b.push_back(static_cast<char>((v >> (8 * i)) & 255));
+  };
+  const std::uint32_t p1 = 8, p2 = p1 + 128 * 96, ifd1 = p2 + 12, ifd2 = ifd1 + 2 + 10 * 12 + 4;
+  b += "II";
+  u16(42);
+  u32(ifd1);
+  b.append(128 * 96, static_cast<char>(200));
+  b.append(12, static_cast<char>(50));
+  const auto ifd = [&](std::uint32_t type, std::uint32_t w, std::uint32_t h, std::uint32_t pixels, std::uint32_t next) {
+    u16(10);
+    const auto entry = [&](std::uint32_t tag, bool is_long, std::uint32_t v) {
+      u16(tag);
+      u16(is_long ? 4 : 3);
+      u32(1);
+      if (is_long) {
+        u32(v);
+      } else {
+        u16(v);
+        u16(0);
+      }
+    };
+    entry(254, true, type);        // NewSubfileType
+    entry(256, false, w);          // ImageWidth
+    entry(257, false, h);          // ImageLength
+    entry(258, false, 8);          // BitsPerSample
+    entry(259, false, 1);          // Compression: none
+    entry(262, false, 1);          // Photometric: black is zero
+    entry(273, true, pixels);      // StripOffsets
+    entry(277, false, 1);          // SamplesPerPixel
+    entry(278, false, h);          // RowsPerStrip
+    entry(279, true, w * h);       // StripByteCounts
+    u32(next);
+  };
+  ifd(0, 128, 96, p1, ifd2);
+  ifd(second_type, 4, 3, p2, 0);
+  return b;
+}
+
+// A folder's images are one frame each: a TIFF stack among them, of which
+// only the first page would be read, is refused, naming it; a second page
+// that is the first's thumbnail does not make a stack. A file named .tif
+// that is another kind of image, given as the input, is one page, and
+// nothing is said of its pages ending early.
+TEST(FrameSource, ATiffStackInAFolderOfImagesIsRefused) {
+  const fs::path dir = folder_of("tiff_in_folder", {});
+  ASSERT_TRUE(cv::imwrite((dir / "a0.png").string(), numbered_frame(0)));
+  std::vector<cv::Mat> pages;
+  for (int i = 1; i < 4; ++i) pages.push_back(numbered_frame(i));
+  ASSERT_TRUE(cv::imwritemulti((dir / "a1.tif").string(), pages));
+  const auto frames_before_refusal = [](const fs::path& folder, std::string& refusal) {
+    int frames = 0;
+    try {
+      auto src = gtrack::open_frame_source(folder.string(), {128, 96}, {}, 25);
+      while (src->next()) ++frames;
+    } catch (const gtrack::InputError& e) {
+      refusal = e.what();
+    }
+    return frames;
+  };
+  std::string refusal;
+  EXPECT_LE(frames_before_refusal(dir, refusal), 1);
+  EXPECT_EQ(refusal, (dir / "a1.tif").string() + ": a TIFF stack of several pages in a folder of images, each of "
+                                                 "which is one frame; give the stack to --input by itself");
+  const fs::path thumbnail = folder_of("tiff_thumbnail", {});
+  std::ofstream(thumbnail / "b.tif", std::ios::binary) << two_page_tiff(1);
+  refusal.clear();
+  EXPECT_EQ(frames_before_refusal(thumbnail, refusal), 1);
+  EXPECT_EQ(refusal, "");
+  std::ofstream(thumbnail / "b.tif", std::ios::binary) << two_page_tiff(0);
+  EXPECT_EQ(frames_before_refusal(thumbnail, refusal), 0);
+  EXPECT_EQ(refusal.rfind((thumbnail / "b.tif").string() + ": a TIFF stack of several pages", 0), 0u) << refusal;
+
+  fs::copy_file(dir / "a0.png", thumbnail / "png.tif");
+  std::unique_ptr<gtrack::FrameSource> src;
+  const auto said =
+      gtrack::testing::logged([&] { src = gtrack::open_frame_source((thumbnail / "png.tif").string(), {128, 96}, {}, 25); });
+  EXPECT_EQ(src->frame_count(), 1);
+  EXPECT_EQ(src->ended_early(), "");
+  EXPECT_EQ(said.find("its pages end"), std::string::npos) << said;
+  EXPECT_TRUE(src->next());
+}
+
 // A TIFF stack (ImageJ/Fiji, Micro-Manager): each page is a frame, 16-bit
 // and grey pages included; a range skips the pages before it, and the
 // backward pass reads its blocks by page.

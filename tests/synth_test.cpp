@@ -213,6 +213,43 @@ TEST(Synth, ALabsStimulusLogDrivesTheMaterial) {
   for (int i = 0; i < o.frames; ++i) EXPECT_DOUBLE_EQ(shifted.frames[i].stimulus, lab.frames[i].stimulus) << i;
 }
 
+// A log kept as the stimulus.csv of the folder the sequence is written to
+// would be replaced by the sequence's own: refused, the log and the folder
+// left as they were.
+TEST(Synth, ALogInTheOutputFolderIsNotOverwritten) {
+  const gtrack::Setup setup = microscope();
+  const fs::path out = fs::temp_directory_path() / "gtrack_synth_log_in_out";
+  fs::remove_all(out);
+  fs::create_directories(out / "frames");
+  const std::string text = "time_s,B_mT,T_C\n0,1,22\n0.05,2,30\n0.1,3,31\n";
+  std::ofstream(out / "stimulus.csv") << text;
+  std::ofstream(out / "ground_truth.csv") << "an earlier sequence's truth\n";
+  gtrack::SynthOptions o;
+  o.frames = 3;
+  o.stimulus_log = out / "." / "stimulus.csv";  // the same file by another name
+  o.stimulus_column = "T_C";
+  try {
+    gtrack::write_synthetic_sequence(setup, o, out);
+    ADD_FAILURE() << "the log was written over";
+  } catch (const gtrack::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(o.stimulus_log->string() + ": is the stimulus log the sequence is made from; "
+                                         "writing the sequence to " + out.string() +
+                                         " would replace it with its stimulus.csv; expected another --out"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ifstream in(out / "stimulus.csv");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), text);
+  EXPECT_TRUE(fs::exists(out / "ground_truth.csv"));
+  // Elsewhere, the same log makes the sequence.
+  fs::rename(out / "stimulus.csv", out.parent_path() / "gtrack_synth_log_in_out.csv");
+  o.stimulus_log = out.parent_path() / "gtrack_synth_log_in_out.csv";
+  EXPECT_EQ(gtrack::write_synthetic_sequence(setup, o, out).frames, 3);
+  EXPECT_TRUE(fs::exists(out / "stimulus.csv"));
+  fs::remove(*o.stimulus_log);
+  fs::remove_all(out);
+}
+
 TEST(Synth, OcclusionScaleShrinksTheOccludersAndKeepsTheRest) {
   const gtrack::Setup setup = microscope();
   gtrack::SynthOptions o;

@@ -25,6 +25,15 @@ SynthSummary write_synthetic_sequence(const Setup& setup, const SynthOptions& op
   // Planned before the folder is touched: a config error leaves it as it was.
   const SynthPlan plan = plan_sequence(setup, options);
   std::error_code ec;
+  // A lab's log kept as OUT/stimulus.csv would be replaced by the sequence's
+  // own (its readings at the frames only): refused before anything is removed.
+  for (const char* name : {"ground_truth.csv", "stimulus.csv", "sequence.toml"}) {
+    if (options.stimulus_log && fs::equivalent(out / name, *options.stimulus_log, ec)) {
+      throw InputError(options.stimulus_log->string() + ": is the stimulus log the sequence is made from; writing " +
+                       "the sequence to " + out.string() + " would replace it with its " + name +
+                       "; expected another --out");
+    }
+  }
   fs::create_directories(out / "frames", ec);
   if (ec) throw InputError(out.string() + ": cannot create the folder (" + ec.message() + ")");
   // The frames of an earlier sequence in the same folder would be tracked

@@ -499,25 +499,38 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
   return image;
 }
 
-// A folder's image named .dcm or .dicom, or without an extension (listed
-// only when it is DICOM): a single-frame DICOM file (one file per frame,
+// A folder's image named .dcm or .dicom, or without an extension or by a
+// UID (listed only when it is DICOM): a single-frame DICOM file (one file per frame,
 // as scanners export), decoded as a DICOM file's frames are; what cannot
 // be read (yet: a file still being written) is said in `said` and gives no
 // image, what is refused for its header throws.
+// A name a scanner may give a DICOM file: none of an image's extensions,
+// as IM_0001, or a UID whose last part reads as one (1.2.840.113619.2.55.3.7).
+bool dicom_by_content(const fs::path& p) {
+  const std::string ext = p.extension().string();
+  return ext.empty() || std::all_of(ext.begin() + 1, ext.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
 bool is_dicom_name(const fs::path& p) {
-  // A folder lists no other file without an extension.
-  return detail::has_dicom_extension(p.string()) || p.extension().empty();
+  // A folder lists no other file of such a name (dicom_by_content) unless it is DICOM.
+  return detail::has_dicom_extension(p.string()) || dicom_by_content(p);
 }
 
 // An image whose header gives the sensor's size in neither orientation is
 // refused before it is decoded (a JPEG's or TIFF's orientation tag may turn
 // the decoded image: that one is judged once decoded).
-void check_header_size(const fs::path& file, ImageSize expected) {
+// A folder's image (`in_folder`) is one frame: a TIFF stack among them,
+// whose first page alone would be read, is refused too.
+void check_header_size(const fs::path& file, ImageSize expected, bool in_folder) {
   if (is_dicom_name(file)) return;  // its preamble may hold another format's header
   std::ifstream in(file, std::ios::binary);
   const std::optional<ImageSize> header = in ? detail::image_header_size(in) : std::nullopt;
   if (header && !(header->width == expected.height && header->height == expected.width)) {
     check_size(*header, expected, file.string());
+  }
+  if (in_folder && in && detail::tiff_has_pages_after_first(in)) {
+    throw InputError(file.string() + ": a TIFF stack of several pages in a folder of images, each of which is one "
+                                     "frame; give the stack to --input by itself");
   }
 }
 
@@ -549,7 +562,7 @@ class FolderSource final : public FrameSource {
     if (files_.empty() && !following()) {
       throw InputError(dir.string() +
                        ": the folder holds no images (.png, .jpg, .bmp, .tif, .pgm, .ppm, .dcm, or DICOM files "
-                       "without an extension)");
+                       "without an extension or named by their UIDs)");
     }
   }
 
@@ -667,9 +680,9 @@ class FolderSource final : public FrameSource {
       const std::string ext = lowercase_extension(it->path());
       if (std::find(exts.begin(), exts.end(), ext) != exts.end()) {
         found.push_back(it->path());
-      } else if (ext.empty()) {
-        // A scanner's export names its DICOM files IM_0001, ... : "DICM"
-        // at byte 128 says what they are. Following, one that does not say
+      } else if (dicom_by_content(it->path())) {
+        // A scanner's export names its DICOM files IM_0001, ..., or by
+        // their UIDs (1.2.840.113619.2.55.3.7): "DICM" at byte 128 says what they are. Following, one that does not say
         // so yet is looked at again until it has been unchanged for 2 s (a
         // writer may set the size first and fill it in later).
         if (detail::is_dicom_file(it->path().string())) {
@@ -808,7 +821,7 @@ class FolderSource final : public FrameSource {
     };
     std::string said;
     if (!following()) {
-      check_header_size(p, expected_);
+      check_header_size(p, expected_, true);
       ReadImage got;
       got.image = decode(said);
       if (got.image.empty()) fail_to_read(p, said);
@@ -834,7 +847,7 @@ class FolderSource final : public FrameSource {
       // whose file times step by seconds, changes neither as it fills.
       if (!decoded || ec || ec_time || size != decoded_size || written != decoded_time ||
           std::chrono::steady_clock::now() - decoded_at > std::chrono::seconds(2)) {
-        check_header_size(p, expected_);  // once whole, the header says what the image will be
+        check_header_size(p, expected_, true);  // once whole, the header says what the image will be
         img = decode(said);
         decoded = true;
         decoded_size = size;
@@ -889,7 +902,7 @@ class FolderSource final : public FrameSource {
   int numbered_steps_ = 0, number_gaps_ = 0;  // consecutive names and gaps so far, see scan()
   bool warned_gap_ = false;
   std::unordered_set<std::string> known_;  // names listed so far
-  bool undecided_ = false;  // the last listing left a file without an extension that may yet be DICOM
+  bool undecided_ = false;  // the last listing left a file (dicom_by_content) that may yet be DICOM
   // See unchanged_since_last_listing().
   bool listed_ = false, mtime_trusted_ = false;
   fs::file_time_type listed_mtime_;
@@ -1027,7 +1040,7 @@ class StackSource final : public FrameSource {
       count_ = pages;
       return;
     }
-    check_header_size(spec_, expected_);  // its first page's, before a block of pages is decoded
+    check_header_size(spec_, expected_, false);  // its first page's, before a block of pages is decoded
     std::string said;
     {
       detail::CapturedStderr library;  // libtiff's warnings about private tags (ImageJ's, OME's)
@@ -1040,6 +1053,10 @@ class StackSource final : public FrameSource {
     }
     if (!said.empty()) logger().debug("{}: the decoder said: {}", spec_, said);
     layout_ = stack_layout(spec_);
+    // (A file named .tif that is another kind of image is one page, which
+    // libtiff, not knowing it, would call a broken chain.)
+    std::ifstream content(spec_, std::ios::binary);
+    if (!detail::is_tiff_content(content)) return;
     if (const std::string broken = stack_directory_error(spec_); !broken.empty()) {
       ended_early_ = "its pages end after page " + std::to_string(count_ - 1) + " with an error (the decoder said: " +
                      library_words(broken) + ")";

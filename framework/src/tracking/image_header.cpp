@@ -111,7 +111,57 @@ std::optional<ImageSize> tiff_size(std::istream& in, bool little) {
   return sized(width, height);
 }
 
+// A classic TIFF's directory after its first, unless it holds a reduced
+// image (NewSubfileType 254 with bit 0 set: a thumbnail of the first).
+bool tiff_second_page(std::istream& in, bool little) {
+  const auto read = [&](std::uint64_t at, int n) -> std::optional<std::uint32_t> {
+    unsigned char v[4];
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(v), n)) return std::nullopt;
+    return little ? little_endian(v, n) : big_endian(v, n);
+  };
+  const auto first = read(4, 4);
+  const auto entries = first ? read(*first, 2) : std::nullopt;
+  const auto second = entries ? read(std::uint64_t{*first} + 2 + 12 * std::uint64_t{*entries}, 4) : std::nullopt;
+  if (!second || *second == 0) return false;
+  const auto count = read(*second, 2);
+  if (!count) return false;
+  for (std::uint32_t i = 0; i < *count; ++i) {
+    const std::uint64_t entry = std::uint64_t{*second} + 2 + 12 * std::uint64_t{i};
+    const auto tag = read(entry, 2), type = read(entry + 2, 2);
+    if (!tag || !type) return false;
+    if (*tag == 254 && (*type == 3 || *type == 4)) {
+      const auto value = read(entry + 8, *type == 3 ? 2 : 4);
+      return value && (*value & 1u) == 0;
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+bool tiff_has_pages_after_first(std::istream& in) {
+  in.clear();
+  in.seekg(0);
+  unsigned char b[4] = {};
+  const bool got = static_cast<bool>(in.read(reinterpret_cast<char*>(b), 4));
+  in.clear();
+  if (!got) return false;
+  if (b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0) return tiff_second_page(in, true);
+  if (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42) return tiff_second_page(in, false);
+  return false;
+}
+
+bool is_tiff_content(std::istream& in) {
+  in.clear();
+  in.seekg(0);
+  unsigned char b[4] = {};
+  const bool got = static_cast<bool>(in.read(reinterpret_cast<char*>(b), 4));
+  in.clear();
+  return got && ((b[0] == 'I' && b[1] == 'I' && (b[2] == 42 || b[2] == 43) && b[3] == 0) ||
+                 (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43)));
+}
 
 std::optional<ImageSize> image_header_size(std::istream& in) {
   in.seekg(0);

@@ -19,4 +19,12 @@ namespace gtrack::detail {
 // wrong. Reads from the stream's start; never throws.
 std::optional<ImageSize> image_header_size(std::istream& in);
 
+// A classic TIFF (by its first bytes) with a page after its first that is
+// not a thumbnail of it (NewSubfileType bit 0): a stack. false for any
+// other file, a BigTIFF or a chain cut short. Never throws.
+bool tiff_has_pages_after_first(std::istream& in);
+
+// The first bytes of a TIFF or a BigTIFF, in either byte order.
+bool is_tiff_content(std::istream& in);
+
 }  // namespace gtrack::detail
