@@ -627,7 +627,12 @@ TEST(Cli, AMissingKeyNamesItsLikelyMisspelling) {
   const std::string base = hydrogel_config();
   const fs::path key = write("fxx.toml", replaced(base, "\nfx = ", "\nfxx = "));
   CliRun r = gtrack("render -c " + key.string() + kParams);
-  expect_refusal(r, "key 'sensor.fx': missing; expected a number in (0, 1e+08] (is 'fxx' on line ");
+  expect_refusal(r, "key 'sensor.fx': missing; expected a number in [1, 1e+08] (is 'fxx' on line ");
+  // A focal length under a pixel is refused by its key, not later by the
+  // projection it makes.
+  const fs::path tiny_focal = write("tiny_focal.toml", replaced(base, "\nfx = 12800.0", "\nfx = 1e-300"));
+  r = gtrack("render -c " + tiny_focal.string() + kParams);
+  expect_refusal(r, "tiny_focal.toml:13: key 'sensor.fx': value 1e-300 is out of range; expected a number in [1, 1e+08]");
   // A key read only when present (the camera's calibration file) is known too.
   const fs::path calibration =
       write("calibraton.toml", replaced(base, "\nfx = ", "\ncalibraton = \"camera.yml\"\nfx = "));

@@ -204,6 +204,36 @@ TEST(PluginLoader, DiscoverySkipsALibraryNamedOtherwise) {
   fs::remove_all(dir);
 }
 
+// A skipped library named as a built-in plugin's file stands ahead of it on
+// the search path: the built-in one is listed, and said to be out of a
+// run's reach, as the run fails on the skipped file.
+TEST(PluginLoader, DiscoverySaysWhenASkippedLibraryHidesAListedOne) {
+  const fs::path dir = fs::temp_directory_path() / "gtrack_loader_hiding";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(kFixtures / "libgtrack_fixture_good_sensor.so", dir / "libgtrack_hydrogel_six_finger.so");
+  gtrack::PluginLoader loader({dir});
+  bool listed = false;
+  const std::string said = gtrack::testing::logged([&] {
+    for (const auto& r : loader.discover()) listed = listed || r.name == "hydrogel_six_finger";
+  });
+  EXPECT_TRUE(listed);
+  EXPECT_NE(said.find("gripper plugin 'hydrogel_six_finger' is listed from "), std::string::npos) << said;
+  EXPECT_NE(said.find("but a run takes " + (dir / "libgtrack_hydrogel_six_finger.so").string() +
+                      " ahead of it, and fails; remove or rename that file"),
+            std::string::npos)
+      << said;
+  const std::string e = plugin_error([&] { loader.make_gripper(table("hydrogel_six_finger", "gripper")); });
+  EXPECT_NE(e.find((dir / "libgtrack_hydrogel_six_finger.so").string() + ": plugin 'fixture_good_sensor' is a sensor"),
+            std::string::npos)
+      << e;
+  // Without it, nothing is said.
+  fs::remove(dir / "libgtrack_hydrogel_six_finger.so");
+  const std::string quiet = gtrack::testing::logged([&] { loader.discover(); });
+  EXPECT_EQ(quiet.find("is listed from"), std::string::npos) << quiet;
+  fs::remove_all(dir);
+}
+
 // A sensor whose projection is not of its image's size (Projection::size
 // left unset) is refused when the setup is loaded, naming both sizes.
 TEST(PluginLoader, ASensorWhoseProjectionIsOfAnotherSizeIsRefused) {

@@ -206,6 +206,20 @@ PluginRecord PluginLoader::inspect(const fs::path& file) {
 std::vector<PluginRecord> PluginLoader::discover() const {
   std::vector<PluginRecord> out;
   std::map<std::string, bool> seen;
+  // Files skipped, by file name: a run looking for that name takes the
+  // skipped one, not a good one of the same name further down the path.
+  std::map<std::string, fs::path> skipped;
+  const auto listed = [&](PluginRecord r, const fs::path& file) {
+    const std::string key = std::string(to_string(r.kind)) + "/" + r.name;
+    if (seen[key]) return;
+    seen[key] = true;
+    if (const auto it = skipped.find(file.filename().string()); it != skipped.end()) {
+      logger().warn("{} plugin '{}' is listed from {}, but a run takes {} ahead of it, and fails; remove or rename "
+                    "that file",
+                    to_string(r.kind), r.name, file.string(), it->second.string());
+    }
+    out.push_back(std::move(r));
+  };
   for (const auto& dir : paths_) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) continue;
@@ -226,14 +240,13 @@ std::vector<PluginRecord> PluginLoader::discover() const {
           logger().warn("skipping {}: it declares the {} plugin '{}', which gtrack looks for as {}; rename the file "
                         "or the name in GTRACK_PLUGIN",
                         f.string(), to_string(r.kind), r.name, library_file_name(r.name));
+          skipped.try_emplace(f.filename().string(), f);
           continue;
         }
-        std::string key = std::string(to_string(r.kind)) + "/" + r.name;
-        if (seen[key]) continue;
-        seen[key] = true;
-        out.push_back(std::move(r));
+        listed(std::move(r), f);
       } catch (const PluginError& e) {
         logger().warn("skipping {}", e.what());
+        skipped.try_emplace(f.filename().string(), f);
       }
     }
   }

@@ -273,8 +273,9 @@ class PinholeMicroscope final : public gtrack::Sensor {
       width_ = static_cast<int>(t.integer("width", Range{1, 65536}));
       height_ = static_cast<int>(t.integer("height", Range{1, 65536}));
       // A focal length of 10^8 pixels sees a hundredth of a micrometre per
-      // pixel at a metre: past it is a typing mistake.
-      const Range focal{0.0, 1e8, true, false};
+      // pixel at a metre: past it is a typing mistake; under one pixel, a
+      // whole half-space falls within the image's first pixels.
+      const Range focal = Range::closed(1.0, 1e8);
       fx_ = t.number("fx", focal);
       fy_ = t.number_or("fy", fx_, focal);
       // cx, cy as calibration tools give them (OpenCV: pixel centres on integers).
