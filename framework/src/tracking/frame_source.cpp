@@ -499,18 +499,19 @@ cv::Mat decode_dicom_frame(const detail::DicomLayout& layout, std::istream& in, 
   return image;
 }
 
-// A folder's image named .dcm or .dicom, or without an extension or by a
-// UID (listed only when it is DICOM): a single-frame DICOM file (one file per frame,
-// as scanners export), decoded as a DICOM file's frames are; what cannot
-// be read (yet: a file still being written) is said in `said` and gives no
-// image, what is refused for its header throws.
-// A name a scanner may give a DICOM file: none of an image's extensions,
-// as IM_0001, or a UID whose last part reads as one (1.2.840.113619.2.55.3.7).
+// A name a scanner may give a DICOM file, which only its content tells:
+// no extension, as IM_0001, or a UID, whose last part reads as one of
+// digits (1.2.840.113619.2.55.3.7).
 bool dicom_by_content(const fs::path& p) {
   const std::string ext = p.extension().string();
   return ext.empty() || std::all_of(ext.begin() + 1, ext.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
+// A folder's image named .dcm or .dicom, or so that only its content tells
+// (listed only when it is DICOM): a single-frame DICOM file (one file per
+// frame, as scanners export), decoded as a DICOM file's frames are; what
+// cannot be read (yet: a file still being written) is said in `said` and
+// gives no image, what is refused for its header throws.
 bool is_dicom_name(const fs::path& p) {
   // A folder lists no other file of such a name (dicom_by_content) unless it is DICOM.
   return detail::has_dicom_extension(p.string()) || dicom_by_content(p);
@@ -682,9 +683,10 @@ class FolderSource final : public FrameSource {
         found.push_back(it->path());
       } else if (dicom_by_content(it->path())) {
         // A scanner's export names its DICOM files IM_0001, ..., or by
-        // their UIDs (1.2.840.113619.2.55.3.7): "DICM" at byte 128 says what they are. Following, one that does not say
-        // so yet is looked at again until it has been unchanged for 2 s (a
-        // writer may set the size first and fill it in later).
+        // their UIDs: "DICM" at byte 128 says what they are. Following,
+        // one that does not say so yet is looked at again until it has
+        // been unchanged for 2 s (a writer may set the size first and fill
+        // it in later).
         if (detail::is_dicom_file(it->path().string())) {
           found.push_back(it->path());
         } else if (following()) {

@@ -84,17 +84,31 @@ std::optional<ImageSize> pnm_size(std::istream& in) {
   return sized(values[0], values[1]);
 }
 
+// n (2 or 4) bytes at `at`, in the file's byte order; none past its end.
+std::optional<std::uint32_t> tiff_number(std::istream& in, bool little, std::uint64_t at, int n) {
+  unsigned char v[4];
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(at));
+  if (!in.read(reinterpret_cast<char*>(v), n)) return std::nullopt;
+  return little ? little_endian(v, n) : big_endian(v, n);
+}
+
+// The file's first four bytes (zeros when it is shorter).
+std::array<unsigned char, 4> first_four_bytes(std::istream& in) {
+  std::array<unsigned char, 4> b{};
+  in.clear();
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(b.data()), 4);
+  if (in.gcount() < 4) b = {};
+  in.clear();
+  return b;
+}
+
 // A classic TIFF's first page: ImageWidth (256) and ImageLength (257) in
 // its first directory, SHORT or LONG, in the file's byte order (a SHORT
 // value sits in the first two bytes of its entry's value field).
 std::optional<ImageSize> tiff_size(std::istream& in, bool little) {
-  const auto read = [&](std::uint64_t at, int n) -> std::optional<std::uint32_t> {
-    unsigned char v[4];
-    in.clear();
-    in.seekg(static_cast<std::streamoff>(at));
-    if (!in.read(reinterpret_cast<char*>(v), n)) return std::nullopt;
-    return little ? little_endian(v, n) : big_endian(v, n);
-  };
+  const auto read = [&](std::uint64_t at, int n) { return tiff_number(in, little, at, n); };
   const auto directory = read(4, 4);
   const auto entries = directory ? read(*directory, 2) : std::nullopt;
   if (!entries) return std::nullopt;
@@ -114,13 +128,7 @@ std::optional<ImageSize> tiff_size(std::istream& in, bool little) {
 // A classic TIFF's directory after its first, unless it holds a reduced
 // image (NewSubfileType 254 with bit 0 set: a thumbnail of the first).
 bool tiff_second_page(std::istream& in, bool little) {
-  const auto read = [&](std::uint64_t at, int n) -> std::optional<std::uint32_t> {
-    unsigned char v[4];
-    in.clear();
-    in.seekg(static_cast<std::streamoff>(at));
-    if (!in.read(reinterpret_cast<char*>(v), n)) return std::nullopt;
-    return little ? little_endian(v, n) : big_endian(v, n);
-  };
+  const auto read = [&](std::uint64_t at, int n) { return tiff_number(in, little, at, n); };
   const auto first = read(4, 4);
   const auto entries = first ? read(*first, 2) : std::nullopt;
   const auto second = entries ? read(std::uint64_t{*first} + 2 + 12 * std::uint64_t{*entries}, 4) : std::nullopt;
@@ -142,25 +150,16 @@ bool tiff_second_page(std::istream& in, bool little) {
 }  // namespace
 
 bool tiff_has_pages_after_first(std::istream& in) {
-  in.clear();
-  in.seekg(0);
-  unsigned char b[4] = {};
-  const bool got = static_cast<bool>(in.read(reinterpret_cast<char*>(b), 4));
-  in.clear();
-  if (!got) return false;
+  const auto b = first_four_bytes(in);
   if (b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0) return tiff_second_page(in, true);
   if (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42) return tiff_second_page(in, false);
   return false;
 }
 
 bool is_tiff_content(std::istream& in) {
-  in.clear();
-  in.seekg(0);
-  unsigned char b[4] = {};
-  const bool got = static_cast<bool>(in.read(reinterpret_cast<char*>(b), 4));
-  in.clear();
-  return got && ((b[0] == 'I' && b[1] == 'I' && (b[2] == 42 || b[2] == 43) && b[3] == 0) ||
-                 (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43)));
+  const auto b = first_four_bytes(in);
+  return (b[0] == 'I' && b[1] == 'I' && (b[2] == 42 || b[2] == 43) && b[3] == 0) ||
+         (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43));
 }
 
 std::optional<ImageSize> image_header_size(std::istream& in) {
